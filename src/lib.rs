@@ -1,0 +1,12 @@
+//! slivermesh: quality, sliver-free Delaunay tetrahedral meshing.
+//!
+//! Layers, top to bottom (each knows only the ones below it):
+//! `ffi` (C ABI) → `api` (safe Rust API) → `io` (file formats) → `plc` (input validation)
+//! → `refine` (Li's REMOVE-SLIVER) → `delaunay` (3D kernel) → `geom` (exact predicates, measures).
+//! See ARCHITECTURE.md.
+
+pub mod delaunay;
+pub mod geom;
+pub mod io;
+
+pub use glam::DVec3;
