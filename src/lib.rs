@@ -3,10 +3,13 @@
 //! Layers, top to bottom (each knows only the ones below it):
 //! `ffi` (C ABI) → `api` (safe Rust API) → `io` (file formats) → `plc` (input validation)
 //! → `refine` (Li's REMOVE-SLIVER) → `delaunay` (3D kernel) → `geom` (exact predicates, measures).
-//! See ARCHITECTURE.md.
+//! `mesh` holds the output model shared by writers and meshers. See ARCHITECTURE.md.
 
 pub mod delaunay;
 pub mod geom;
 pub mod io;
+pub mod mesh;
+pub mod plc;
 
 pub use glam::DVec3;
+pub use mesh::TetMesh;
