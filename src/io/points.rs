@@ -1,0 +1,1 @@
+//! Reader for plain point files: one `x y z` per line.
