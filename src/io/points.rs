@@ -146,7 +146,7 @@ mod tests {
             1.0 / 3.0,
             6.02214076e23,
             -1e-300,
-            0.7853981633974483,
+            std::f64::consts::FRAC_PI_4,
         ];
         let text: String = vals.iter().map(|v| format!("{v} {v} {v}\n")).collect();
         let pts = parse(&text).unwrap();
