@@ -8,7 +8,7 @@
 
 use super::tables::FACE;
 use super::{Delaunay, Inserted, INFINITE, NO_TET};
-use crate::geom::{insphere_sos, orient3d};
+use crate::geom::{insphere, insphere_tie, orient3d};
 use glam::DVec3;
 use rustc_hash::FxHashMap;
 
@@ -53,11 +53,12 @@ impl Delaunay {
     /// Inserts vertex `id` (its coordinates already stored), locating from tet `hint`.
     pub(super) fn insert_vertex(&mut self, id: u32, hint: u32) -> Inserted {
         let p = self.points[id as usize];
+        let rank = self.rank[id as usize];
         let start = self.locate(p, hint);
         if let Some(dup) = self.coincident_vertex(start, p) {
             return Inserted::Duplicate(dup);
         }
-        self.find_cavity(p, id, start);
+        self.find_cavity(p, rank, start);
         self.fill_cavity(id);
         self.n_vertices += 1;
         Inserted::New(id)
@@ -96,8 +97,8 @@ impl Delaunay {
             .find(|&v| v != INFINITE && self.points[v as usize] == p)
     }
 
-    /// Whether tet `t` conflicts with point `p` of rank `rank`.
-    fn in_conflict(&self, t: u32, p: DVec3, rank: u32) -> bool {
+    /// Whether tet `t` conflicts with point `p` of perturbation rank `rank`.
+    pub(super) fn in_conflict(&self, t: u32, p: DVec3, rank: u32) -> bool {
         let v = self.tet_v[t as usize];
         match v.iter().position(|&x| x == INFINITE) {
             None => self.finite_in_conflict(t, p, rank),
@@ -123,7 +124,11 @@ impl Delaunay {
     fn finite_in_conflict(&self, t: u32, p: DVec3, rank: u32) -> bool {
         let v = self.tet_v[t as usize];
         let q = v.map(|i| self.points[i as usize]);
-        insphere_sos(q, v, p, rank)
+        let s = insphere(q[0], q[1], q[2], q[3], p);
+        if s != 0.0 {
+            return s > 0.0;
+        }
+        insphere_tie(q, v.map(|i| self.rank[i as usize]), p, rank)
     }
 
     /// Grows the cavity of `p` from `start` (which must conflict) into the scratch buffers.

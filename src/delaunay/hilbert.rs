@@ -7,7 +7,8 @@ use glam::DVec3;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 
-const BITS: u32 = 16;
+/// Cell resolution per axis: 2^30 cells separate far more points than we ever sort.
+const BITS: u32 = 10;
 /// Rounds shrink by this factor (CGAL's multiscale ratio is 1/8).
 const ROUND_RATIO: usize = 8;
 /// Below this size a round is not split further.

@@ -87,6 +87,9 @@ pub struct Delaunay {
     points: Vec<DVec3>,
     /// One alive tet incident to each vertex, `NO_TET` if the vertex is not inserted.
     vertex_tet: Vec<u32>,
+    /// Symbolic-perturbation rank of each vertex: its insertion index (bulk) or its id (later
+    /// insertions). Fixed for the vertex's lifetime so every tie is decided the same way.
+    rank: Vec<u32>,
     tet_v: Vec<[u32; 4]>,
     tet_n: Vec<[u32; 4]>,
     /// Scratch stamp per tet for cavity searches (never read across calls).
@@ -113,10 +116,14 @@ impl Delaunay {
                 reason,
             })?;
         }
+        // Build over the points in insertion order, so that vertices close in space are close
+        // in memory (and the newest point always has the highest rank), then renumber to the
+        // caller's ids.
         let order = hilbert::brio_order(points, 0x5eed);
         let mut dt = Delaunay {
-            points: points.to_vec(),
+            points: order.iter().map(|&i| points[i as usize]).collect(),
             vertex_tet: vec![NO_TET; points.len()],
+            rank: (0..points.len() as u32).collect(),
             rng: 0x9e37_79b9,
             ..Default::default()
         };
@@ -125,12 +132,13 @@ impl Delaunay {
         dt.tet_v.reserve(expected);
         dt.tet_n.reserve(expected);
         dt.mark.reserve(expected);
-        let first = dt.initial_tet(&order)?;
+        let sequence: Vec<u32> = (0..points.len() as u32).collect();
+        let first = dt.initial_tet(&sequence)?;
         let mut stats = InsertStats {
             inserted: 4,
             duplicates: 0,
         };
-        for &id in &order {
+        for id in 0..points.len() as u32 {
             if first.contains(&id) {
                 continue;
             }
@@ -140,6 +148,7 @@ impl Delaunay {
                 Inserted::Duplicate(_) => stats.duplicates += 1,
             }
         }
+        dt.renumber(&order, points);
         Ok((dt, stats))
     }
 
@@ -157,11 +166,13 @@ impl Delaunay {
         })?;
         self.points.push(p);
         self.vertex_tet.push(NO_TET);
+        self.rank.push(index as u32);
         let hint = hint.filter(|&t| self.is_alive(t)).unwrap_or(self.last);
         let r = self.insert_vertex(index as u32, hint);
         if let Inserted::Duplicate(_) = r {
             self.points.pop();
             self.vertex_tet.pop();
+            self.rank.pop();
         }
         Ok(r)
     }
@@ -238,11 +249,34 @@ impl Delaunay {
         use std::mem::size_of;
         self.points.capacity() * size_of::<DVec3>()
             + self.vertex_tet.capacity() * 4
+            + self.rank.capacity() * 4
             + self.tet_v.capacity() * 16
             + self.tet_n.capacity() * 16
             + self.mark.capacity() * 4
             + self.free.capacity() * 4
             + self.scratch.memory_bytes()
+    }
+
+    /// Renames internal vertex `i` to `order[i]` and restores the caller's point order.
+    fn renumber(&mut self, order: &[u32], points: &[DVec3]) {
+        for tet in self.tet_v.iter_mut() {
+            for v in tet.iter_mut() {
+                if *v != INFINITE && *v != DEAD {
+                    *v = order[*v as usize];
+                }
+            }
+        }
+        let mut vertex_tet = vec![NO_TET; points.len()];
+        for (i, &t) in self.vertex_tet.iter().enumerate() {
+            vertex_tet[order[i] as usize] = t;
+        }
+        self.vertex_tet = vertex_tet;
+        self.rank = vec![0; points.len()];
+        for (i, &o) in order.iter().enumerate() {
+            self.rank[o as usize] = i as u32;
+        }
+        self.points.clear();
+        self.points.extend_from_slice(points);
     }
 
     /// Picks four affinely independent points (earliest in `order`), builds their tet and the

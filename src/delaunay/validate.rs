@@ -84,7 +84,13 @@ impl Delaunay {
         let t_finite = !v.contains(&INFINITE);
         if t_finite && apex != INFINITE {
             let q = self.tet_points(t);
-            if insphere_sos(q, v, self.points[apex as usize], apex) {
+            let ranks = v.map(|x| self.rank[x as usize]);
+            if insphere_sos(
+                q,
+                ranks,
+                self.points[apex as usize],
+                self.rank[apex as usize],
+            ) {
                 return Err(format!(
                     "face {i} of tet {t} {v:?} is not locally Delaunay: vertex {apex} is inside"
                 ));
