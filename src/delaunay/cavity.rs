@@ -80,7 +80,7 @@ impl Delaunay {
             .boundary
             .iter()
             .map(|&(t, i)| {
-                let v = self.tet_v[t as usize];
+                let v = self.tets[t as usize].v;
                 FACE[i as usize].map(|k| v[k])
             })
             .collect();
@@ -91,7 +91,8 @@ impl Delaunay {
     }
 
     fn coincident_vertex(&self, t: u32, p: DVec3) -> Option<u32> {
-        self.tet_v[t as usize]
+        self.tets[t as usize]
+            .v
             .iter()
             .copied()
             .find(|&v| v != INFINITE && self.points[v as usize] == p)
@@ -99,7 +100,7 @@ impl Delaunay {
 
     /// Whether tet `t` conflicts with point `p` of perturbation rank `rank`.
     pub(super) fn in_conflict(&self, t: u32, p: DVec3, rank: u32) -> bool {
-        let v = self.tet_v[t as usize];
+        let v = self.tets[t as usize].v;
         match v.iter().position(|&x| x == INFINITE) {
             None => self.finite_in_conflict(t, p, rank),
             Some(k) => {
@@ -113,7 +114,7 @@ impl Delaunay {
                 if o != 0.0 {
                     o > 0.0
                 } else {
-                    let behind = self.tet_n[t as usize][k] >> 2;
+                    let behind = self.tets[t as usize].n[k] >> 2;
                     self.finite_in_conflict(behind, p, rank)
                 }
             }
@@ -122,7 +123,7 @@ impl Delaunay {
 
     #[inline]
     fn finite_in_conflict(&self, t: u32, p: DVec3, rank: u32) -> bool {
-        let v = self.tet_v[t as usize];
+        let v = self.tets[t as usize].v;
         let q = v.map(|i| self.points[i as usize]);
         let s = insphere(q[0], q[1], q[2], q[3], p);
         if s != 0.0 {
@@ -133,38 +134,40 @@ impl Delaunay {
 
     /// Grows the cavity of `p` from `start` (which must conflict) into the scratch buffers.
     fn find_cavity(&mut self, p: DVec3, rank: u32, start: u32) {
-        if self.stamp >= u32::MAX - 4 {
-            self.mark.iter_mut().for_each(|m| *m = 0);
-            self.stamp = 0;
-        }
-        self.stamp += 2;
-        let inside = self.stamp;
-        let outside = inside + 1;
+        const INSIDE: u8 = 1;
+        const OUTSIDE: u8 = 2;
         let mut s = std::mem::take(&mut self.scratch);
         s.cavity.clear();
         s.boundary.clear();
         s.stack.clear();
-        self.mark[start as usize] = inside;
+        self.mark[start as usize] = INSIDE;
         s.cavity.push(start);
         s.stack.push(start);
         while let Some(t) = s.stack.pop() {
             for i in 0..4 {
-                let n = self.tet_n[t as usize][i] >> 2;
+                let n = self.tets[t as usize].n[i] >> 2;
                 let m = self.mark[n as usize];
-                if m == inside {
+                if m == INSIDE {
                     continue;
                 }
-                if m != outside {
+                if m != OUTSIDE {
                     if self.in_conflict(n, p, rank) {
-                        self.mark[n as usize] = inside;
+                        self.mark[n as usize] = INSIDE;
                         s.cavity.push(n);
                         s.stack.push(n);
                         continue;
                     }
-                    self.mark[n as usize] = outside;
+                    self.mark[n as usize] = OUTSIDE;
                 }
                 s.boundary.push((t, i as u8));
             }
+        }
+        // Leave every mark at zero for the next search.
+        for &t in &s.cavity {
+            self.mark[t as usize] = 0;
+        }
+        for &(t, i) in &s.boundary {
+            self.mark[(self.tets[t as usize].n[i as usize] >> 2) as usize] = 0;
         }
         self.scratch = s;
     }
@@ -174,9 +177,9 @@ impl Delaunay {
         let mut s = std::mem::take(&mut self.scratch);
         s.faces.clear();
         for &(t, i) in &s.boundary {
-            let v = self.tet_v[t as usize];
+            let v = self.tets[t as usize].v;
             let face = FACE[i as usize].map(|k| v[k]);
-            s.faces.push((face, self.tet_n[t as usize][i as usize]));
+            s.faces.push((face, self.tets[t as usize].n[i as usize]));
         }
         for &t in &s.cavity {
             self.free_tet(t);

@@ -13,15 +13,15 @@ impl Delaunay {
     pub(super) fn locate(&mut self, p: DVec3, start: u32) -> u32 {
         let mut t = start;
         if let Some(k) = self.infinite_index(t) {
-            t = self.tet_n[t as usize][k] >> 2;
+            t = self.tets[t as usize].n[k] >> 2;
         }
         let mut came_from = u32::MAX;
         'walk: loop {
-            let v = self.tet_v[t as usize];
+            let v = self.tets[t as usize].v;
             let r = self.next_random() as usize;
             for k in 0..4 {
                 let i = (r + k) & 3;
-                let n = self.tet_n[t as usize][i] >> 2;
+                let n = self.tets[t as usize].n[i] >> 2;
                 if n == came_from {
                     continue; // we crossed this face towards p: p is on our side of it
                 }
@@ -47,6 +47,6 @@ impl Delaunay {
     /// Local index of the infinite vertex of tet `t`, if it is a hull tet.
     #[inline]
     pub(super) fn infinite_index(&self, t: u32) -> Option<usize> {
-        self.tet_v[t as usize].iter().position(|&v| v == INFINITE)
+        self.tets[t as usize].v.iter().position(|&v| v == INFINITE)
     }
 }

@@ -8,7 +8,7 @@
 //! infinity ([`INFINITE`]).
 //!
 //! Storage: per tet 4 vertex ids and 4 neighbour references (`tet * 4 + face`, `face` = local
-//! index of the opposite vertex in the neighbour) plus one scratch mark: 36 bytes. Deleted
+//! index of the opposite vertex in the neighbour) plus a one-byte scratch mark: 33 bytes. Deleted
 //! slots go to a free list. Limits: fewer than 2^30 tets and 2^32 - 2 vertices; coordinates as
 //! accepted by `geom::check_coordinate`.
 
@@ -81,6 +81,15 @@ pub enum Inserted {
     Duplicate(u32),
 }
 
+/// One tet: 4 vertex ids and 4 neighbour references (`tet * 4 + face`), in one 32-byte
+/// block so a conflict test touches a single cache line.
+#[derive(Debug, Clone, Copy, Default)]
+#[repr(C, align(32))]
+struct Tet {
+    v: [u32; 4],
+    n: [u32; 4],
+}
+
 /// The 3D Delaunay triangulation of a point set.
 #[derive(Debug, Clone, Default)]
 pub struct Delaunay {
@@ -90,11 +99,9 @@ pub struct Delaunay {
     /// Symbolic-perturbation rank of each vertex: its insertion index (bulk) or its id (later
     /// insertions). Fixed for the vertex's lifetime so every tie is decided the same way.
     rank: Vec<u32>,
-    tet_v: Vec<[u32; 4]>,
-    tet_n: Vec<[u32; 4]>,
-    /// Scratch stamp per tet for cavity searches (never read across calls).
-    mark: Vec<u32>,
-    stamp: u32,
+    tets: Vec<Tet>,
+    /// Scratch flag per tet for cavity searches; zero between calls.
+    mark: Vec<u8>,
     free: Vec<u32>,
     n_alive: usize,
     n_ghost: usize,
@@ -129,8 +136,7 @@ impl Delaunay {
         };
         // Euler: ~6.7 tets per point for uniform points; reserving avoids a doubling peak.
         let expected = points.len() * 27 / 4 + 64;
-        dt.tet_v.reserve(expected);
-        dt.tet_n.reserve(expected);
+        dt.tets.reserve(expected);
         dt.mark.reserve(expected);
         let sequence: Vec<u32> = (0..points.len() as u32).collect();
         let first = dt.initial_tet(&sequence)?;
@@ -212,37 +218,37 @@ impl Delaunay {
     }
     /// Upper bound (exclusive) of tet ids, alive or not.
     pub fn tet_capacity(&self) -> usize {
-        self.tet_v.len()
+        self.tets.len()
     }
     pub fn is_alive(&self, t: u32) -> bool {
-        self.tet_v.get(t as usize).is_some_and(|v| v[0] != DEAD)
+        self.tets.get(t as usize).is_some_and(|t| t.v[0] != DEAD)
     }
     /// Whether alive tet `t` is finite (carries no infinite vertex).
     pub fn is_finite(&self, t: u32) -> bool {
-        !self.tet_v[t as usize].contains(&INFINITE)
+        !self.tets[t as usize].v.contains(&INFINITE)
     }
     /// Vertex ids of tet `t` (positively oriented if finite).
     pub fn tet(&self, t: u32) -> [u32; 4] {
-        self.tet_v[t as usize]
+        self.tets[t as usize].v
     }
     /// Neighbour tets of `t`; entry i is across the face opposite vertex i.
     pub fn neighbors(&self, t: u32) -> [u32; 4] {
-        self.tet_n[t as usize].map(|r| r >> 2)
+        self.tets[t as usize].n.map(|r| r >> 2)
     }
     /// Corner coordinates of finite tet `t`.
     pub fn tet_points(&self, t: u32) -> [DVec3; 4] {
-        self.tet_v[t as usize].map(|v| self.points[v as usize])
+        self.tets[t as usize].v.map(|v| self.points[v as usize])
     }
     /// Ids of all alive finite tets.
     pub fn finite_tet_ids(&self) -> impl Iterator<Item = u32> + '_ {
-        (0..self.tet_v.len() as u32).filter(|&t| {
-            let v = &self.tet_v[t as usize];
+        (0..self.tets.len() as u32).filter(|&t| {
+            let v = &self.tets[t as usize].v;
             v[0] != DEAD && !v.contains(&INFINITE)
         })
     }
     /// Positively oriented finite tets as vertex id quadruples.
     pub fn finite_tets(&self) -> impl Iterator<Item = [u32; 4]> + '_ {
-        self.finite_tet_ids().map(|t| self.tet_v[t as usize])
+        self.finite_tet_ids().map(|t| self.tets[t as usize].v)
     }
     /// Heap bytes held by the triangulation (arrays' capacities).
     pub fn memory_bytes(&self) -> usize {
@@ -250,17 +256,16 @@ impl Delaunay {
         self.points.capacity() * size_of::<DVec3>()
             + self.vertex_tet.capacity() * 4
             + self.rank.capacity() * 4
-            + self.tet_v.capacity() * 16
-            + self.tet_n.capacity() * 16
-            + self.mark.capacity() * 4
+            + self.tets.capacity() * std::mem::size_of::<Tet>()
+            + self.mark.capacity()
             + self.free.capacity() * 4
             + self.scratch.memory_bytes()
     }
 
     /// Renames internal vertex `i` to `order[i]` and restores the caller's point order.
     fn renumber(&mut self, order: &[u32], points: &[DVec3]) {
-        for tet in self.tet_v.iter_mut() {
-            for v in tet.iter_mut() {
+        for tet in self.tets.iter_mut() {
+            for v in tet.v.iter_mut() {
                 if *v != INFINITE && *v != DEAD {
                     *v = order[*v as usize];
                 }
@@ -327,7 +332,7 @@ impl Delaunay {
     fn link_by_faces(&mut self, tets: &[u32]) {
         let mut faces: Vec<([u32; 3], u32)> = vec![];
         for &t in tets {
-            let v = self.tet_v[t as usize];
+            let v = self.tets[t as usize].v;
             for (i, f) in FACE.iter().enumerate() {
                 let mut key = [v[f[0]], v[f[1]], v[f[2]]];
                 key.sort_unstable();
@@ -344,7 +349,7 @@ impl Delaunay {
 
     #[inline]
     fn set_neighbor(&mut self, from: u32, to: u32) {
-        self.tet_n[(from >> 2) as usize][(from & 3) as usize] = to;
+        self.tets[(from >> 2) as usize].n[(from & 3) as usize] = to;
     }
 
     fn alloc_tet(&mut self, v: [u32; 4]) -> u32 {
@@ -353,23 +358,24 @@ impl Delaunay {
             self.n_ghost += 1;
         }
         if let Some(t) = self.free.pop() {
-            self.tet_v[t as usize] = v;
-            self.mark[t as usize] = 0;
+            self.tets[t as usize].v = v;
             t
         } else {
-            self.tet_v.push(v);
-            self.tet_n.push([u32::MAX; 4]);
+            self.tets.push(Tet {
+                v,
+                n: [u32::MAX; 4],
+            });
             self.mark.push(0);
-            (self.tet_v.len() - 1) as u32
+            (self.tets.len() - 1) as u32
         }
     }
 
     fn free_tet(&mut self, t: u32) {
         self.n_alive -= 1;
-        if self.tet_v[t as usize].contains(&INFINITE) {
+        if self.tets[t as usize].v.contains(&INFINITE) {
             self.n_ghost -= 1;
         }
-        self.tet_v[t as usize] = [DEAD; 4];
+        self.tets[t as usize].v = [DEAD; 4];
         self.free.push(t);
     }
 

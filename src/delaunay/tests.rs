@@ -284,14 +284,14 @@ fn validate_catches_corruption() {
     let (dt, _) = Delaunay::from_points(&pts).unwrap();
     let t = dt.finite_tet_ids().next().unwrap();
     let mut flipped = dt.clone();
-    flipped.tet_v[t as usize].swap(0, 1);
+    flipped.tets[t as usize].v.swap(0, 1);
     assert!(flipped.validate().unwrap_err().contains("orient"));
     let mut unlinked = dt.clone();
-    unlinked.tet_n[t as usize][0] = unlinked.tet_n[t as usize][1];
+    unlinked.tets[t as usize].n[0] = unlinked.tets[t as usize].n[1];
     assert!(unlinked.validate().is_err());
     // Moving a vertex slightly breaks the empty-sphere property somewhere.
     let mut moved = dt.clone();
-    let v = moved.tet_v[t as usize][0];
+    let v = moved.tets[t as usize].v[0];
     let centre = moved.points.iter().sum::<DVec3>() / 200.0;
     moved.points[v as usize] = moved.points[v as usize].lerp(centre, 0.3);
     assert!(moved.validate().is_err());

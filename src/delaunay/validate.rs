@@ -12,8 +12,8 @@ impl Delaunay {
     pub fn validate(&self) -> Result<(), String> {
         let mut alive = 0;
         let mut ghosts = 0;
-        for t in 0..self.tet_v.len() as u32 {
-            let v = self.tet_v[t as usize];
+        for t in 0..self.tets.len() as u32 {
+            let v = self.tets[t as usize].v;
             if v[0] == DEAD {
                 continue;
             }
@@ -31,18 +31,18 @@ impl Delaunay {
                 }
             }
             for i in 0..4 {
-                let r = self.tet_n[t as usize][i];
+                let r = self.tets[t as usize].n[i];
                 let (n, j) = (r >> 2, (r & 3) as usize);
                 if !self.is_alive(n) {
                     return Err(format!("tet {t} face {i}: neighbour {n} is not alive"));
                 }
-                if self.tet_n[n as usize][j] != t * 4 + i as u32 {
+                if self.tets[n as usize].n[j] != t * 4 + i as u32 {
                     return Err(format!(
                         "tet {t} face {i}: neighbour {n} does not point back"
                     ));
                 }
                 let mut mine = FACE[i].map(|k| v[k]);
-                let w = self.tet_v[n as usize];
+                let w = self.tets[n as usize].v;
                 let mut theirs = FACE[j].map(|k| w[k]);
                 mine.sort_unstable();
                 theirs.sort_unstable();
@@ -64,7 +64,7 @@ impl Delaunay {
                 continue;
             }
             n_vertices += 1;
-            if !self.is_alive(t) || !self.tet_v[t as usize].contains(&(v as u32)) {
+            if !self.is_alive(t) || !self.tets[t as usize].v.contains(&(v as u32)) {
                 return Err(format!("vertex {v}: incident tet {t} does not hold it"));
             }
         }
@@ -79,8 +79,8 @@ impl Delaunay {
 
     /// Local Delaunay / convexity across face i of t (shared with face j of n).
     fn check_face(&self, t: u32, i: usize, n: u32, j: usize) -> Result<(), String> {
-        let v = self.tet_v[t as usize];
-        let apex = self.tet_v[n as usize][j];
+        let v = self.tets[t as usize].v;
+        let apex = self.tets[n as usize].v[j];
         let t_finite = !v.contains(&INFINITE);
         if t_finite && apex != INFINITE {
             let q = self.tet_points(t);
