@@ -125,13 +125,8 @@ fn dihedral_rad(n1: DVec3, n2: DVec3, det: f64, len: f64) -> f64 {
 /// edges by cosine (monotone in the angle) and evaluates only those two angles accurately.
 #[inline(always)]
 fn min_max_dihedral_from(n: &[DVec3; 4], l2: &[f64; 6], det: f64) -> (f64, f64) {
-    let len = [
-        n[0].length(),
-        n[1].length(),
-        n[2].length(),
-        n[3].length(),
-    ];
-    if det == 0.0 || len.iter().any(|&x| x == 0.0) {
+    let len = [n[0].length(), n[1].length(), n[2].length(), n[3].length()];
+    if det == 0.0 || len.contains(&0.0) {
         return (0.0, 180.0);
     }
     let (mut imin, mut imax) = (0usize, 0usize);
@@ -162,8 +157,11 @@ fn min_max_dihedral_from(n: &[DVec3; 4], l2: &[f64; 6], det: f64) -> (f64, f64) 
 /// zero) or the centre is not representable.
 ///
 /// Shewchuk's formula relative to a, with the adaptive orientation determinant in the
-/// denominator: c = a + (|u|²(v×w) + |v|²(w×u) + |w|²(u×v)) / (2·det[u,v,w]),
-/// u = b-a, v = c-a, w = d-a. Independent of the orientation of (a, b, c, d).
+/// denominator: `c = a + (|u|²(v×w) + |v|²(w×u) + |w|²(u×v)) / (2·det[u, v, w])` with
+/// `u = b-a, v = c-a, w = d-a`. Independent of the orientation of (a, b, c, d).
+///
+/// A near-flat tet has an ill-conditioned centre (a perturbation of the vertices moves it by
+/// about R/sigma times as much; the tests see an absolute error within ε·R/sigma).
 #[inline]
 pub fn circumcenter(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Option<DVec3> {
     circumsphere(a, b, c, d).map(|(center, _)| center)
@@ -189,7 +187,7 @@ pub fn circumradius(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
 /// three vertices (the centre of a subfacet's equatorial ball). `None` for collinear or
 /// coincident points.
 ///
-/// c = a + (|u|²(v×n) + |v|²(n×u)) / (2|n|²), u = b-a, v = c-a, n = u×v.
+/// `c = a + (|u|²(v×n) + |v|²(n×u)) / (2|n|²)` with `u = b-a, v = c-a, n = u×v`.
 #[inline]
 pub fn tri_circumcenter(a: DVec3, b: DVec3, c: DVec3) -> Option<DVec3> {
     equatorial_ball(a, b, c).map(|(center, _)| center)
@@ -324,7 +322,9 @@ pub fn min_max_dihedral(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> (f64, f64) {
 ///
 /// A flat tet (exact orientation 0, which includes coincident vertices) gets rho = aspect =
 /// circumradius = +∞, sigma = volume = 0, dihedral angles (0, 180) and no circumcentre; its
-/// `shortest_edge` is still the real one. No field is ever NaN for finite input.
+/// `shortest_edge` is still the real one. The same values are reported if the circumcentre
+/// overflows, which needs coordinates outside the accepted range ([`super::MAX_COORD`]).
+/// No field is ever NaN for finite input.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TetQuality {
     /// Radius-edge ratio R/L (regular: [`REGULAR_RHO`]).
@@ -402,7 +402,7 @@ impl TetQuality {
         }
     }
 
-    /// True for a flat tet (exact orientation zero).
+    /// True for a flat tet (exact orientation zero; see the type's documentation).
     #[inline]
     pub fn is_flat(&self) -> bool {
         self.circumcenter.is_none()
@@ -543,7 +543,11 @@ mod tests {
         close(inradius(a, b, c, d), 1.0 / (3.0 + 3f64.sqrt()), 1e-15);
         close(radius_edge_ratio(a, b, c, d), 3f64.sqrt() / 2.0, 1e-15);
         close(sigma(a, b, c, d), 1.0 / 6.0, 1e-15);
-        close(aspect(a, b, c, d), 3f64.sqrt() / 2.0 * (3.0 + 3f64.sqrt()) / 3.0, 1e-15);
+        close(
+            aspect(a, b, c, d),
+            3f64.sqrt() / 2.0 * (3.0 + 3f64.sqrt()) / 3.0,
+            1e-15,
+        );
         let acute = (1.0 / 3f64.sqrt()).acos().to_degrees();
         close(acute, 54.735_610_317_245_35, 1e-15);
         let ang = dihedral_angles(a, b, c, d);
@@ -575,7 +579,10 @@ mod tests {
         close(volume(a, b, c, d), vol, tol);
         close(inradius(a, b, c, d), r, tol);
         close(shortest_edge(a, b, c, d), l, tol);
-        let longest = (p * p + qq * qq).max(p * p + s * s).max(qq * qq + s * s).sqrt();
+        let longest = (p * p + qq * qq)
+            .max(p * p + s * s)
+            .max(qq * qq + s * s)
+            .sqrt();
         close(longest_edge(a, b, c, d), longest, tol);
         close(radius_edge_ratio(a, b, c, d), big_r / l, tol);
         close(sigma(a, b, c, d), vol / (l * l * l), tol);
@@ -626,7 +633,11 @@ mod tests {
         // sigma = 1/(6 eps): a needle is not a sliver
         close(tq.sigma, 1.0 / (6.0 * eps), 1e-14);
         // two dihedral angles tend to 45°, none to 0 or 180
-        close(tq.min_dihedral, (1.0 / (2.0 + eps * eps).sqrt()).acos().to_degrees(), 1e-12);
+        close(
+            tq.min_dihedral,
+            (1.0 / (2.0 + eps * eps).sqrt()).acos().to_degrees(),
+            1e-12,
+        );
         close(tq.max_dihedral, 90.0, 1e-12);
         assert!(tq.aspect > 100.0);
     }
@@ -648,7 +659,11 @@ mod tests {
             let r = e / (1.0 + 4.0 * e * e).sqrt();
             close(inradius(a, b, c, d) / r, 1.0, 1e-12);
             // rho stays near 1/√2: the radius-edge ratio does not see slivers ...
-            close(radius_edge_ratio(a, b, c, d), (1.0 + e * e).sqrt() / l, 1e-14);
+            close(
+                radius_edge_ratio(a, b, c, d),
+                (1.0 + e * e).sqrt() / l,
+                1e-14,
+            );
             // ... sigma does
             let sig = 4.0 * e / 3.0 / (l * l * l);
             close(sigma(a, b, c, d) / sig, 1.0, 1e-12);
@@ -675,7 +690,14 @@ mod tests {
             close(tq.rho, (1.0 + e * e).sqrt() / l, 1e-14);
         }
         // sigma → 0 and the max angle → 180 as the sliver flattens
-        assert!(sigma(sliver(1e-9)[0], sliver(1e-9)[1], sliver(1e-9)[2], sliver(1e-9)[3]) < 1e-9);
+        assert!(
+            sigma(
+                sliver(1e-9)[0],
+                sliver(1e-9)[1],
+                sliver(1e-9)[2],
+                sliver(1e-9)[3]
+            ) < 1e-9
+        );
         assert!(q(sliver(1e-9)).max_dihedral > 180.0 - 1e-6);
     }
 
@@ -752,7 +774,11 @@ mod tests {
         close(hi, ang.iter().copied().fold(0.0, f64::max), 1e-15);
         // volume: sum over faces of (1/3) * area * distance from the in-centre ... use instead
         // the independent triple product
-        close(volume(a, b, c, d), (b - a).dot((c - a).cross(d - a)) / 6.0, 1e-15);
+        close(
+            volume(a, b, c, d),
+            (b - a).dot((c - a).cross(d - a)) / 6.0,
+            1e-15,
+        );
         // TetQuality agrees with the individual functions
         let tq = q(t);
         close(tq.rho, radius_edge_ratio(a, b, c, d), 1e-15);
@@ -862,7 +888,11 @@ mod tests {
         close(tq.shortest_edge / edge, 1.0, 1e-12);
         close_v(tq.circumcenter.unwrap(), shift, 1e-12);
         close(longest_edge(a, b, c, d) / edge, 1.0, 1e-12);
-        close(inradius(a, b, c, d) / (edge / (2.0 * 6f64.sqrt())), 1.0, 1e-12);
+        close(
+            inradius(a, b, c, d) / (edge / (2.0 * 6f64.sqrt())),
+            1.0,
+            1e-12,
+        );
         for x in dihedral_angles(a, b, c, d) {
             close(x, REGULAR_DIHEDRAL, 1e-10);
         }
@@ -916,7 +946,11 @@ mod tests {
         let (ca, cb) = (a - cc, b - cc);
         let sin_c = ca.cross(cb).length() / (ca.length() * cb.length());
         close(rad, 4.0 / (2.0 * sin_c), 1e-14);
-        close_v(rot.inverse() * (centre - shift), DVec3::new(2.0, -2.75, 0.0), 1e-14);
+        close_v(
+            rot.inverse() * (centre - shift),
+            DVec3::new(2.0, -2.75, 0.0),
+            1e-14,
+        );
         // collinear and coincident: none
         assert_eq!(tri_circumcenter(o, x, 3.0 * x), None);
         assert_eq!(equatorial_ball(y, y, z), None);
