@@ -20,8 +20,11 @@ pub(super) struct Scratch {
     /// Cavity boundary as (cavity tet, local face) pairs.
     boundary: Vec<(u32, u8)>,
     stack: Vec<u32>,
-    /// Boundary faces copied out before their tets are reused: vertices + outer neighbour ref.
-    faces: Vec<([u32; 3], u32)>,
+    /// Boundary faces copied out before their tets are reused: vertices, outer neighbour ref,
+    /// tag of the cavity tet that owned the face.
+    faces: Vec<([u32; 3], u32, u32)>,
+    /// Tets created by the last insertion.
+    pub(super) created: Vec<u32>,
     /// Directed boundary edge -> face reference of the new tet that owns it.
     edges: FxHashMap<u64, u32>,
 }
@@ -31,7 +34,8 @@ impl Scratch {
         self.cavity.capacity() * 4
             + self.boundary.capacity() * 8
             + self.stack.capacity() * 4
-            + self.faces.capacity() * 16
+            + self.faces.capacity() * 20
+            + self.created.capacity() * 4
             + self.edges.capacity() * 12
     }
 }
@@ -179,14 +183,20 @@ impl Delaunay {
         for &(t, i) in &s.boundary {
             let v = self.tets[t as usize].v;
             let face = FACE[i as usize].map(|k| v[k]);
-            s.faces.push((face, self.tets[t as usize].n[i as usize]));
+            let tag = self.tags.get(t as usize).copied().unwrap_or(0);
+            s.faces.push((face, self.tets[t as usize].n[i as usize], tag));
         }
         for &t in &s.cavity {
             self.free_tet(t);
         }
         s.edges.clear();
-        for &(face, outer) in &s.faces {
+        s.created.clear();
+        for &(face, outer, tag) in &s.faces {
             let t = self.alloc_tet([face[0], face[1], face[2], id]);
+            s.created.push(t);
+            if self.tags_enabled {
+                self.tags[t as usize] = tag;
+            }
             let me = t * 4 + 3;
             self.set_neighbor(me, outer);
             self.set_neighbor(outer, me);

@@ -103,6 +103,10 @@ pub struct Delaunay {
     /// Scratch flag per tet for cavity searches; zero between calls.
     mark: Vec<u8>,
     free: Vec<u32>,
+    /// Optional caller data per tet (e.g. region), inherited by the tets a cavity creates from
+    /// the cavity tet on the other side of their outer face; empty unless enabled.
+    tags: Vec<u32>,
+    tags_enabled: bool,
     n_alive: usize,
     n_ghost: usize,
     n_vertices: usize,
@@ -262,6 +266,70 @@ impl Delaunay {
             + self.scratch.memory_bytes()
     }
 
+    /// Turns on per-tet tags (all zero now); new tets inherit the tag of the cavity tet they
+    /// replace across their outer face, so a region label survives insertions that do not
+    /// cross region boundaries.
+    pub fn enable_tags(&mut self) {
+        self.tags = vec![0; self.tets.len()];
+        self.tags_enabled = true;
+    }
+    pub fn tag(&self, t: u32) -> u32 {
+        self.tags[t as usize]
+    }
+    pub fn set_tag(&mut self, t: u32, tag: u32) {
+        self.tags[t as usize] = tag;
+    }
+    /// Tets created by the last successful insertion (all incident to the new vertex).
+    pub fn last_created(&self) -> &[u32] {
+        &self.scratch.created
+    }
+
+    /// All alive tets incident to vertex `v` (hull tets included).
+    pub fn vertex_star(&self, v: u32) -> Vec<u32> {
+        let Some(start) = self.vertex_tet(v) else {
+            return vec![];
+        };
+        let mut star = vec![start];
+        let mut k = 0;
+        while k < star.len() {
+            let t = star[k];
+            k += 1;
+            let tv = self.tets[t as usize].v;
+            for i in 0..4 {
+                if tv[i] == v {
+                    continue; // the face opposite v does not contain v
+                }
+                let n = self.tets[t as usize].n[i] >> 2;
+                if !star.contains(&n) {
+                    star.push(n);
+                }
+            }
+        }
+        star
+    }
+
+    /// A tet having both `a` and `b` as vertices (i.e. edge ab exists), if any.
+    pub fn find_edge(&self, a: u32, b: u32) -> Option<u32> {
+        self.vertex_star(a)
+            .into_iter()
+            .find(|&t| self.tets[t as usize].v.contains(&b))
+    }
+
+    /// The tets (one or two) having face abc, with the local index of their fourth vertex.
+    pub fn find_face(&self, a: u32, b: u32, c: u32) -> Option<[(u32, usize); 2]> {
+        let t = self
+            .vertex_star(a)
+            .into_iter()
+            .find(|&t| {
+                let v = self.tets[t as usize].v;
+                v.contains(&b) && v.contains(&c)
+            })?;
+        let v = self.tets[t as usize].v;
+        let i = (0..4).find(|&i| v[i] != a && v[i] != b && v[i] != c).unwrap();
+        let r = self.tets[t as usize].n[i];
+        Some([(t, i), (r >> 2, (r & 3) as usize)])
+    }
+
     /// Renames internal vertex `i` to `order[i]` and restores the caller's point order.
     fn renumber(&mut self, order: &[u32], points: &[DVec3]) {
         for tet in self.tets.iter_mut() {
@@ -366,6 +434,9 @@ impl Delaunay {
                 n: [u32::MAX; 4],
             });
             self.mark.push(0);
+            if self.tags_enabled {
+                self.tags.push(0);
+            }
             (self.tets.len() - 1) as u32
         }
     }
