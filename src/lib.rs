@@ -10,6 +10,7 @@ pub mod geom;
 pub mod io;
 pub mod mesh;
 pub mod plc;
+pub mod refine;
 
 pub use glam::DVec3;
 pub use mesh::TetMesh;

@@ -1,11 +1,34 @@
 //! Incremental 3D Delaunay tetrahedralization (Bowyer–Watson) over flat arrays.
 //!
-//! STUB: the public interface is fixed; bodies are being written.
+//! Algorithms: BRIO + Hilbert insertion order ([`hilbert`]); stochastic visibility walk from a
+//! hint ([`locate`]); conflict region ("cavity") grown with the exact in-sphere test and
+//! retriangulated as a star from the new point ([`cavity`]); symbolic perturbation by vertex id
+//! for cospherical ties (`geom::insphere_sos`), so grids and other degenerate inputs give one
+//! consistent triangulation. The hull is closed by "ghost" tets that carry the vertex at
+//! infinity ([`INFINITE`]).
+//!
+//! Storage: per tet 4 vertex ids and 4 neighbour references (`tet * 4 + face`, `face` = local
+//! index of the opposite vertex in the neighbour) plus a one-byte scratch mark: 33 bytes. Deleted
+//! slots go to a free list. Limits: fewer than 2^30 tets and 2^32 - 2 vertices; coordinates as
+//! accepted by `geom::check_coordinate`.
 
+mod cavity;
+pub mod hilbert;
+mod locate;
+pub mod tables;
+mod validate;
+
+use crate::geom::{self, orient3d};
+pub use cavity::DryRun;
 use glam::DVec3;
+use tables::FACE;
 
 /// Id of the vertex at infinity (hull tets carry it).
 pub const INFINITE: u32 = u32::MAX;
+/// Vertex id stored in all four slots of a deleted tet.
+const DEAD: u32 = u32::MAX - 1;
+/// "No tet" (a vertex not in the triangulation).
+pub const NO_TET: u32 = u32::MAX;
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum DelaunayError {
@@ -13,10 +36,12 @@ pub enum DelaunayError {
     BadCoordinate {
         index: usize,
         point: DVec3,
-        reason: crate::geom::CoordError,
+        reason: geom::CoordError,
     },
     /// Fewer than four affinely independent points: no tetrahedron exists.
     Degenerate { reason: String },
+    /// The triangulation has no tet yet (single insertions need `from_points` first).
+    Empty,
 }
 
 impl std::fmt::Display for DelaunayError {
@@ -26,14 +51,13 @@ impl std::fmt::Display for DelaunayError {
                 index,
                 point,
                 reason,
-            } => {
-                write!(
-                    f,
-                    "point {index} ({}, {}, {}): {reason}",
-                    point.x, point.y, point.z
-                )
-            }
+            } => write!(
+                f,
+                "point {index} ({}, {}, {}): {reason}",
+                point.x, point.y, point.z
+            ),
             DelaunayError::Degenerate { reason } => write!(f, "degenerate input: {reason}"),
+            DelaunayError::Empty => write!(f, "the triangulation has no tetrahedron yet"),
         }
     }
 }
@@ -57,48 +81,396 @@ pub enum Inserted {
     Duplicate(u32),
 }
 
+/// One tet: 4 vertex ids and 4 neighbour references (`tet * 4 + face`), in one 32-byte
+/// block so a conflict test touches a single cache line.
+#[derive(Debug, Clone, Copy, Default)]
+#[repr(C, align(32))]
+struct Tet {
+    v: [u32; 4],
+    n: [u32; 4],
+}
+
+/// The 3D Delaunay triangulation of a point set.
+#[derive(Debug, Clone, Default)]
 pub struct Delaunay {
     points: Vec<DVec3>,
+    /// One alive tet incident to each vertex, `NO_TET` if the vertex is not inserted.
+    vertex_tet: Vec<u32>,
+    /// Symbolic-perturbation rank of each vertex: its insertion index (bulk) or its id (later
+    /// insertions). Fixed for the vertex's lifetime so every tie is decided the same way.
+    rank: Vec<u32>,
+    tets: Vec<Tet>,
+    /// Scratch flag per tet for cavity searches; zero between calls.
+    mark: Vec<u8>,
+    free: Vec<u32>,
+    /// Optional caller data per tet (e.g. region), inherited by the tets a cavity creates from
+    /// the cavity tet on the other side of their outer face; empty unless enabled.
+    tags: Vec<u32>,
+    tags_enabled: bool,
+    n_alive: usize,
+    n_ghost: usize,
+    n_vertices: usize,
+    /// Hint for the next location: the last tet created.
+    last: u32,
+    rng: u32,
+    scratch: cavity::Scratch,
 }
 
 impl Delaunay {
     /// Triangulates `points`; vertex id i is `points[i]` (duplicates are skipped, ids unused).
     /// Inserts in BRIO / Hilbert order.
     pub fn from_points(points: &[DVec3]) -> Result<(Self, InsertStats), DelaunayError> {
-        let _ = points;
-        todo!()
+        for (index, &p) in points.iter().enumerate() {
+            geom::check_coordinate(p).map_err(|reason| DelaunayError::BadCoordinate {
+                index,
+                point: p,
+                reason,
+            })?;
+        }
+        // Build over the points in insertion order, so that vertices close in space are close
+        // in memory (and the newest point always has the highest rank), then renumber to the
+        // caller's ids.
+        let order = hilbert::brio_order(points, 0x5eed);
+        let mut dt = Delaunay {
+            points: order.iter().map(|&i| points[i as usize]).collect(),
+            vertex_tet: vec![NO_TET; points.len()],
+            rank: (0..points.len() as u32).collect(),
+            rng: 0x9e37_79b9,
+            ..Default::default()
+        };
+        // Euler: ~6.7 tets per point for uniform points; reserving avoids a doubling peak.
+        let expected = points.len() * 27 / 4 + 64;
+        dt.tets.reserve(expected);
+        dt.mark.reserve(expected);
+        let sequence: Vec<u32> = (0..points.len() as u32).collect();
+        let first = dt.initial_tet(&sequence)?;
+        let mut stats = InsertStats {
+            inserted: 4,
+            duplicates: 0,
+        };
+        for id in 0..points.len() as u32 {
+            if first.contains(&id) {
+                continue;
+            }
+            let hint = dt.last;
+            match dt.insert_vertex(id, hint) {
+                Inserted::New(_) => stats.inserted += 1,
+                Inserted::Duplicate(_) => stats.duplicates += 1,
+            }
+        }
+        dt.renumber(&order, points);
+        Ok((dt, stats))
     }
-    /// Inserts one point (locating from `hint`, a tet id, when given). Needs a triangulation
-    /// with at least one tet (use `from_points` first).
+
+    /// Inserts one point, locating it from `hint` (a tet id) or from the last insertion.
+    /// A duplicate of an existing vertex changes nothing and consumes no id.
     pub fn insert(&mut self, p: DVec3, hint: Option<u32>) -> Result<Inserted, DelaunayError> {
-        let _ = (p, hint);
-        todo!()
+        if self.n_alive == 0 {
+            return Err(DelaunayError::Empty);
+        }
+        let index = self.points.len();
+        geom::check_coordinate(p).map_err(|reason| DelaunayError::BadCoordinate {
+            index,
+            point: p,
+            reason,
+        })?;
+        self.points.push(p);
+        self.vertex_tet.push(NO_TET);
+        self.rank.push(index as u32);
+        let hint = hint.filter(|&t| self.is_alive(t)).unwrap_or(self.last);
+        let r = self.insert_vertex(index as u32, hint);
+        if let Inserted::Duplicate(_) = r {
+            self.points.pop();
+            self.vertex_tet.pop();
+            self.rank.pop();
+        }
+        Ok(r)
     }
+
     /// Number of vertex ids handed out (including skipped duplicates).
     pub fn num_vertex_ids(&self) -> usize {
         self.points.len()
     }
     /// Number of vertices actually in the triangulation.
     pub fn num_vertices(&self) -> usize {
-        todo!()
+        self.n_vertices
     }
+    /// Number of finite (non-hull) tets.
     pub fn num_finite_tets(&self) -> usize {
-        todo!()
+        self.n_alive - self.n_ghost
     }
     /// Coordinates of vertex `v`.
     pub fn point(&self, v: u32) -> DVec3 {
         self.points[v as usize]
     }
+    /// All vertex coordinates, indexed by vertex id.
+    pub fn points(&self) -> &[DVec3] {
+        &self.points
+    }
+    /// Whether vertex `v` is in the triangulation (false for skipped duplicates).
+    pub fn has_vertex(&self, v: u32) -> bool {
+        self.vertex_tet
+            .get(v as usize)
+            .is_some_and(|&t| t != NO_TET)
+    }
+    /// An alive tet incident to vertex `v`, if `v` is in the triangulation.
+    pub fn vertex_tet(&self, v: u32) -> Option<u32> {
+        self.vertex_tet
+            .get(v as usize)
+            .copied()
+            .filter(|&t| t != NO_TET)
+    }
+    /// Upper bound (exclusive) of tet ids, alive or not.
+    pub fn tet_capacity(&self) -> usize {
+        self.tets.len()
+    }
+    pub fn is_alive(&self, t: u32) -> bool {
+        self.tets.get(t as usize).is_some_and(|t| t.v[0] != DEAD)
+    }
+    /// Whether alive tet `t` is finite (carries no infinite vertex).
+    pub fn is_finite(&self, t: u32) -> bool {
+        !self.tets[t as usize].v.contains(&INFINITE)
+    }
+    /// Vertex ids of tet `t` (positively oriented if finite).
+    pub fn tet(&self, t: u32) -> [u32; 4] {
+        self.tets[t as usize].v
+    }
+    /// Neighbour tets of `t`; entry i is across the face opposite vertex i.
+    pub fn neighbors(&self, t: u32) -> [u32; 4] {
+        self.tets[t as usize].n.map(|r| r >> 2)
+    }
+    /// Corner coordinates of finite tet `t`.
+    pub fn tet_points(&self, t: u32) -> [DVec3; 4] {
+        self.tets[t as usize].v.map(|v| self.points[v as usize])
+    }
+    /// Ids of all alive finite tets.
+    pub fn finite_tet_ids(&self) -> impl Iterator<Item = u32> + '_ {
+        (0..self.tets.len() as u32).filter(|&t| {
+            let v = &self.tets[t as usize].v;
+            v[0] != DEAD && !v.contains(&INFINITE)
+        })
+    }
     /// Positively oriented finite tets as vertex id quadruples.
     pub fn finite_tets(&self) -> impl Iterator<Item = [u32; 4]> + '_ {
-        std::iter::empty()
+        self.finite_tet_ids().map(|t| self.tets[t as usize].v)
     }
     /// Heap bytes held by the triangulation (arrays' capacities).
     pub fn memory_bytes(&self) -> usize {
-        todo!()
+        use std::mem::size_of;
+        self.points.capacity() * size_of::<DVec3>()
+            + self.vertex_tet.capacity() * 4
+            + self.rank.capacity() * 4
+            + self.tets.capacity() * std::mem::size_of::<Tet>()
+            + self.mark.capacity()
+            + self.free.capacity() * 4
+            + self.scratch.memory_bytes()
     }
-    /// Full structural + Delaunay check (tests only; O(n)).
-    pub fn validate(&self) -> Result<(), String> {
-        todo!()
+
+    /// Turns on per-tet tags (all zero now); new tets inherit the tag of the cavity tet they
+    /// replace across their outer face, so a region label survives insertions that do not
+    /// cross region boundaries.
+    pub fn enable_tags(&mut self) {
+        self.tags = vec![0; self.tets.len()];
+        self.tags_enabled = true;
+    }
+    pub fn tag(&self, t: u32) -> u32 {
+        self.tags[t as usize]
+    }
+    pub fn set_tag(&mut self, t: u32, tag: u32) {
+        self.tags[t as usize] = tag;
+    }
+    /// Tets created by the last successful insertion (all incident to the new vertex).
+    pub fn last_created(&self) -> &[u32] {
+        &self.scratch.created
+    }
+
+    /// All alive tets incident to vertex `v` (hull tets included).
+    pub fn vertex_star(&self, v: u32) -> Vec<u32> {
+        let Some(start) = self.vertex_tet(v) else {
+            return vec![];
+        };
+        let mut star = vec![start];
+        let mut k = 0;
+        while k < star.len() {
+            let t = star[k];
+            k += 1;
+            let tv = self.tets[t as usize].v;
+            for i in 0..4 {
+                if tv[i] == v {
+                    continue; // the face opposite v does not contain v
+                }
+                let n = self.tets[t as usize].n[i] >> 2;
+                if !star.contains(&n) {
+                    star.push(n);
+                }
+            }
+        }
+        star
+    }
+
+    /// A tet having both `a` and `b` as vertices (i.e. edge ab exists), if any.
+    pub fn find_edge(&self, a: u32, b: u32) -> Option<u32> {
+        self.vertex_star(a)
+            .into_iter()
+            .find(|&t| self.tets[t as usize].v.contains(&b))
+    }
+
+    /// The tets (one or two) having face abc, with the local index of their fourth vertex.
+    pub fn find_face(&self, a: u32, b: u32, c: u32) -> Option<[(u32, usize); 2]> {
+        let t = self
+            .vertex_star(a)
+            .into_iter()
+            .find(|&t| {
+                let v = self.tets[t as usize].v;
+                v.contains(&b) && v.contains(&c)
+            })?;
+        let v = self.tets[t as usize].v;
+        let i = (0..4).find(|&i| v[i] != a && v[i] != b && v[i] != c).unwrap();
+        let r = self.tets[t as usize].n[i];
+        Some([(t, i), (r >> 2, (r & 3) as usize)])
+    }
+
+    /// Renames internal vertex `i` to `order[i]` and restores the caller's point order.
+    fn renumber(&mut self, order: &[u32], points: &[DVec3]) {
+        for tet in self.tets.iter_mut() {
+            for v in tet.v.iter_mut() {
+                if *v != INFINITE && *v != DEAD {
+                    *v = order[*v as usize];
+                }
+            }
+        }
+        let mut vertex_tet = vec![NO_TET; points.len()];
+        for (i, &t) in self.vertex_tet.iter().enumerate() {
+            vertex_tet[order[i] as usize] = t;
+        }
+        self.vertex_tet = vertex_tet;
+        self.rank = vec![0; points.len()];
+        for (i, &o) in order.iter().enumerate() {
+            self.rank[o as usize] = i as u32;
+        }
+        self.points.clear();
+        self.points.extend_from_slice(points);
+    }
+
+    /// Picks four affinely independent points (earliest in `order`), builds their tet and the
+    /// four hull tets around it.
+    fn initial_tet(&mut self, order: &[u32]) -> Result<[u32; 4], DelaunayError> {
+        let p = |i: u32| self.points[i as usize];
+        let degenerate = |reason: &str| DelaunayError::Degenerate {
+            reason: reason.to_string(),
+        };
+        let a = *order.first().ok_or_else(|| degenerate("no points"))?;
+        let b = *order
+            .iter()
+            .find(|&&i| p(i) != p(a))
+            .ok_or_else(|| degenerate("all points coincide"))?;
+        let c = *order
+            .iter()
+            .find(|&&i| !collinear(p(a), p(b), p(i)))
+            .ok_or_else(|| degenerate("all points are collinear"))?;
+        let mut d = *order
+            .iter()
+            .find(|&&i| orient3d(p(a), p(b), p(c), p(i)) != 0.0)
+            .ok_or_else(|| degenerate("all points are coplanar"))?;
+        let mut a = a;
+        if orient3d(p(a), p(b), p(c), p(d)) < 0.0 {
+            std::mem::swap(&mut a, &mut d);
+            // swapping two vertices flips the orientation
+        }
+        let tet = [a, b, c, d];
+        debug_assert!(orient3d(p(a), p(b), p(c), p(d)) > 0.0);
+        let t0 = self.alloc_tet(tet);
+        let mut ghosts = [0u32; 4];
+        for (i, g) in ghosts.iter_mut().enumerate() {
+            let f = FACE[i];
+            // The hull face seen from outside is the reversed face: INF lies beyond it.
+            *g = self.alloc_tet([tet[f[1]], tet[f[0]], tet[f[2]], INFINITE]);
+        }
+        let all = [t0, ghosts[0], ghosts[1], ghosts[2], ghosts[3]];
+        self.link_by_faces(&all);
+        for v in tet {
+            self.vertex_tet[v as usize] = t0;
+        }
+        self.n_vertices = 4;
+        self.last = t0;
+        Ok(tet)
+    }
+
+    /// Links the faces shared among `tets` (a small set; used at initialisation).
+    fn link_by_faces(&mut self, tets: &[u32]) {
+        let mut faces: Vec<([u32; 3], u32)> = vec![];
+        for &t in tets {
+            let v = self.tets[t as usize].v;
+            for (i, f) in FACE.iter().enumerate() {
+                let mut key = [v[f[0]], v[f[1]], v[f[2]]];
+                key.sort_unstable();
+                faces.push((key, t * 4 + i as u32));
+            }
+        }
+        faces.sort_unstable();
+        for pair in faces.chunks(2) {
+            assert!(pair.len() == 2 && pair[0].0 == pair[1].0, "unpaired face");
+            self.set_neighbor(pair[0].1, pair[1].1);
+            self.set_neighbor(pair[1].1, pair[0].1);
+        }
+    }
+
+    #[inline]
+    fn set_neighbor(&mut self, from: u32, to: u32) {
+        self.tets[(from >> 2) as usize].n[(from & 3) as usize] = to;
+    }
+
+    fn alloc_tet(&mut self, v: [u32; 4]) -> u32 {
+        self.n_alive += 1;
+        if v.contains(&INFINITE) {
+            self.n_ghost += 1;
+        }
+        if let Some(t) = self.free.pop() {
+            self.tets[t as usize].v = v;
+            t
+        } else {
+            self.tets.push(Tet {
+                v,
+                n: [u32::MAX; 4],
+            });
+            self.mark.push(0);
+            if self.tags_enabled {
+                self.tags.push(0);
+            }
+            (self.tets.len() - 1) as u32
+        }
+    }
+
+    fn free_tet(&mut self, t: u32) {
+        self.n_alive -= 1;
+        if self.tets[t as usize].v.contains(&INFINITE) {
+            self.n_ghost -= 1;
+        }
+        self.tets[t as usize].v = [DEAD; 4];
+        self.free.push(t);
+    }
+
+    /// Cheap xorshift for the walk's random first face.
+    #[inline]
+    fn next_random(&mut self) -> u32 {
+        let mut x = self.rng;
+        x ^= x << 13;
+        x ^= x >> 17;
+        x ^= x << 5;
+        self.rng = x;
+        x
     }
 }
+
+/// Exact collinearity: the three points are collinear iff all three coordinate-plane
+/// projections are (exactly) collinear. Each 2D orientation is an exact orient3d with a lifted
+/// apex.
+fn collinear(a: DVec3, b: DVec3, c: DVec3) -> bool {
+    let lift = |p: DVec3, i: usize, j: usize| DVec3::new(p[i], p[j], 0.0);
+    [(0, 1), (1, 2), (0, 2)]
+        .iter()
+        .all(|&(i, j)| orient3d(lift(a, i, j), lift(b, i, j), lift(c, i, j), DVec3::Z) == 0.0)
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,238 @@
+//! The conflict region ("cavity") of a point and its star retriangulation (Bowyer–Watson).
+//!
+//! A finite tet conflicts with p when p is inside its circumsphere (perturbed in-sphere, so
+//! ties never happen); a hull tet conflicts when p is strictly outside its hull face or, when
+//! p lies on the hull face's plane, exactly when the finite tet behind that face conflicts
+//! (the sphere meets the plane in the face's circumcircle). The cavity is the connected set of
+//! conflicting tets around the tet containing p; its boundary is star-shaped from p.
+
+use super::tables::FACE;
+use super::{Delaunay, Inserted, INFINITE, NO_TET};
+use crate::geom::{insphere, insphere_tie, orient3d};
+use glam::DVec3;
+use rustc_hash::FxHashMap;
+
+/// Reusable buffers for cavity searches.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Scratch {
+    /// Tets in conflict.
+    cavity: Vec<u32>,
+    /// Cavity boundary as (cavity tet, local face) pairs.
+    boundary: Vec<(u32, u8)>,
+    stack: Vec<u32>,
+    /// Boundary faces copied out before their tets are reused: vertices, outer neighbour ref,
+    /// tag of the cavity tet that owned the face.
+    faces: Vec<([u32; 3], u32, u32)>,
+    /// Tets created by the last insertion.
+    pub(super) created: Vec<u32>,
+    /// Directed boundary edge -> face reference of the new tet that owns it.
+    edges: FxHashMap<u64, u32>,
+}
+
+impl Scratch {
+    pub(super) fn memory_bytes(&self) -> usize {
+        self.cavity.capacity() * 4
+            + self.boundary.capacity() * 8
+            + self.stack.capacity() * 4
+            + self.faces.capacity() * 20
+            + self.created.capacity() * 4
+            + self.edges.capacity() * 12
+    }
+}
+
+/// What inserting a point would do, computed without changing the triangulation.
+#[derive(Debug, Clone, PartialEq)]
+pub enum DryRun {
+    /// The point equals this vertex.
+    Duplicate(u32),
+    /// Inserting the point would delete `removed` tets and create one tet `(a, b, c, p)` per
+    /// face `[a, b, c]` (positively oriented; a face holding `INFINITE` makes a hull tet).
+    Cavity {
+        removed: Vec<u32>,
+        faces: Vec<[u32; 3]>,
+    },
+}
+
+impl Delaunay {
+    /// Inserts vertex `id` (its coordinates already stored), locating from tet `hint`.
+    pub(super) fn insert_vertex(&mut self, id: u32, hint: u32) -> Inserted {
+        let p = self.points[id as usize];
+        let rank = self.rank[id as usize];
+        let start = self.locate(p, hint);
+        if let Some(dup) = self.coincident_vertex(start, p) {
+            return Inserted::Duplicate(dup);
+        }
+        self.find_cavity(p, rank, start);
+        self.fill_cavity(id);
+        self.n_vertices += 1;
+        Inserted::New(id)
+    }
+
+    /// The tets a new point at `p` would remove and the faces it would connect to, without
+    /// changing the triangulation (refinement tests candidate points with this). `hint` is a
+    /// tet to start the walk from (any alive tet).
+    pub fn dry_run(&mut self, p: DVec3, hint: Option<u32>) -> DryRun {
+        let hint = hint.filter(|&t| self.is_alive(t)).unwrap_or(self.last);
+        let start = self.locate(p, hint);
+        if let Some(dup) = self.coincident_vertex(start, p) {
+            return DryRun::Duplicate(dup);
+        }
+        // The would-be vertex ranks above every existing one, as a real insertion would.
+        self.find_cavity(p, self.points.len() as u32, start);
+        let faces = self
+            .scratch
+            .boundary
+            .iter()
+            .map(|&(t, i)| {
+                let v = self.tets[t as usize].v;
+                FACE[i as usize].map(|k| v[k])
+            })
+            .collect();
+        DryRun::Cavity {
+            removed: self.scratch.cavity.clone(),
+            faces,
+        }
+    }
+
+    fn coincident_vertex(&self, t: u32, p: DVec3) -> Option<u32> {
+        self.tets[t as usize]
+            .v
+            .iter()
+            .copied()
+            .find(|&v| v != INFINITE && self.points[v as usize] == p)
+    }
+
+    /// Whether tet `t` conflicts with point `p` of perturbation rank `rank`.
+    pub(super) fn in_conflict(&self, t: u32, p: DVec3, rank: u32) -> bool {
+        let v = self.tets[t as usize].v;
+        match v.iter().position(|&x| x == INFINITE) {
+            None => self.finite_in_conflict(t, p, rank),
+            Some(k) => {
+                let f = FACE[k];
+                let o = orient3d(
+                    self.points[v[f[0]] as usize],
+                    self.points[v[f[1]] as usize],
+                    self.points[v[f[2]] as usize],
+                    p,
+                );
+                if o != 0.0 {
+                    o > 0.0
+                } else {
+                    let behind = self.tets[t as usize].n[k] >> 2;
+                    self.finite_in_conflict(behind, p, rank)
+                }
+            }
+        }
+    }
+
+    #[inline]
+    fn finite_in_conflict(&self, t: u32, p: DVec3, rank: u32) -> bool {
+        let v = self.tets[t as usize].v;
+        let q = v.map(|i| self.points[i as usize]);
+        let s = insphere(q[0], q[1], q[2], q[3], p);
+        if s != 0.0 {
+            return s > 0.0;
+        }
+        insphere_tie(q, v.map(|i| self.rank[i as usize]), p, rank)
+    }
+
+    /// Grows the cavity of `p` from `start` (which must conflict) into the scratch buffers.
+    fn find_cavity(&mut self, p: DVec3, rank: u32, start: u32) {
+        const INSIDE: u8 = 1;
+        const OUTSIDE: u8 = 2;
+        let mut s = std::mem::take(&mut self.scratch);
+        s.cavity.clear();
+        s.boundary.clear();
+        s.stack.clear();
+        self.mark[start as usize] = INSIDE;
+        s.cavity.push(start);
+        s.stack.push(start);
+        while let Some(t) = s.stack.pop() {
+            for i in 0..4 {
+                let n = self.tets[t as usize].n[i] >> 2;
+                let m = self.mark[n as usize];
+                if m == INSIDE {
+                    continue;
+                }
+                if m != OUTSIDE {
+                    if self.in_conflict(n, p, rank) {
+                        self.mark[n as usize] = INSIDE;
+                        s.cavity.push(n);
+                        s.stack.push(n);
+                        continue;
+                    }
+                    self.mark[n as usize] = OUTSIDE;
+                }
+                s.boundary.push((t, i as u8));
+            }
+        }
+        // Leave every mark at zero for the next search.
+        for &t in &s.cavity {
+            self.mark[t as usize] = 0;
+        }
+        for &(t, i) in &s.boundary {
+            self.mark[(self.tets[t as usize].n[i as usize] >> 2) as usize] = 0;
+        }
+        self.scratch = s;
+    }
+
+    /// Replaces the cavity in the scratch buffers by the star of vertex `id`.
+    fn fill_cavity(&mut self, id: u32) {
+        let mut s = std::mem::take(&mut self.scratch);
+        s.faces.clear();
+        for &(t, i) in &s.boundary {
+            let v = self.tets[t as usize].v;
+            let face = FACE[i as usize].map(|k| v[k]);
+            let tag = self.tags.get(t as usize).copied().unwrap_or(0);
+            s.faces.push((face, self.tets[t as usize].n[i as usize], tag));
+        }
+        for &t in &s.cavity {
+            self.free_tet(t);
+        }
+        s.edges.clear();
+        s.created.clear();
+        for &(face, outer, tag) in &s.faces {
+            let t = self.alloc_tet([face[0], face[1], face[2], id]);
+            s.created.push(t);
+            if self.tags_enabled {
+                self.tags[t as usize] = tag;
+            }
+            let me = t * 4 + 3;
+            self.set_neighbor(me, outer);
+            self.set_neighbor(outer, me);
+            // Face j (j < 3) holds the new vertex and the boundary edge face[j+1] -> face[j+2];
+            // the neighbouring boundary face runs along that edge the other way.
+            for j in 0..3 {
+                let (a, b) = (face[(j + 1) % 3], face[(j + 2) % 3]);
+                let mine = t * 4 + j as u32;
+                match s.edges.remove(&edge_key(b, a)) {
+                    Some(other) => {
+                        self.set_neighbor(mine, other);
+                        self.set_neighbor(other, mine);
+                    }
+                    None => {
+                        s.edges.insert(edge_key(a, b), mine);
+                    }
+                }
+            }
+            for v in face {
+                if v != INFINITE {
+                    self.vertex_tet[v as usize] = t;
+                }
+            }
+            self.vertex_tet[id as usize] = t;
+            self.last = t;
+        }
+        debug_assert!(
+            s.edges.is_empty(),
+            "cavity boundary is not a closed surface"
+        );
+        debug_assert!(self.vertex_tet[id as usize] != NO_TET);
+        self.scratch = s;
+    }
+}
+
+#[inline]
+fn edge_key(a: u32, b: u32) -> u64 {
+    ((a as u64) << 32) | b as u64
+}

@@ -1,0 +1,52 @@
+//! Point location by a stochastic visibility walk (Devillers, Pion, Teillaud, "Walking in a
+//! triangulation", 2002): from the current tet, cross a face that has the query point strictly
+//! beyond it, testing faces from a random start so the walk cannot cycle.
+
+use super::tables::FACE;
+use super::{Delaunay, INFINITE};
+use crate::geom::orient3d;
+use glam::DVec3;
+
+impl Delaunay {
+    /// Returns a finite tet whose closure contains `p`, or a hull tet whose hull face has `p`
+    /// strictly outside it.
+    pub(super) fn locate(&mut self, p: DVec3, start: u32) -> u32 {
+        let mut t = start;
+        if let Some(k) = self.infinite_index(t) {
+            t = self.tets[t as usize].n[k] >> 2;
+        }
+        let mut came_from = u32::MAX;
+        'walk: loop {
+            let v = self.tets[t as usize].v;
+            let r = self.next_random() as usize;
+            for k in 0..4 {
+                let i = (r + k) & 3;
+                let n = self.tets[t as usize].n[i] >> 2;
+                if n == came_from {
+                    continue; // we crossed this face towards p: p is on our side of it
+                }
+                let f = FACE[i];
+                let (a, b, c) = (
+                    self.points[v[f[0]] as usize],
+                    self.points[v[f[1]] as usize],
+                    self.points[v[f[2]] as usize],
+                );
+                if orient3d(a, b, c, p) < 0.0 {
+                    if self.infinite_index(n).is_some() {
+                        return n;
+                    }
+                    came_from = t;
+                    t = n;
+                    continue 'walk;
+                }
+            }
+            return t;
+        }
+    }
+
+    /// Local index of the infinite vertex of tet `t`, if it is a hull tet.
+    #[inline]
+    pub(super) fn infinite_index(&self, t: u32) -> Option<usize> {
+        self.tets[t as usize].v.iter().position(|&v| v == INFINITE)
+    }
+}

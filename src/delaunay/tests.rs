@@ -1,0 +1,298 @@
+//! Kernel tests: validity on uniform, clustered, grid, sphere and coplanar-start inputs, counts
+//! against an independent brute-force Delaunay, dry runs, duplicates and errors.
+
+use super::*;
+use crate::geom::insphere;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+fn uniform(n: usize, seed: u64) -> Vec<DVec3> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    (0..n)
+        .map(|_| DVec3::new(rng.gen(), rng.gen(), rng.gen()))
+        .collect()
+}
+
+fn grid(k: usize) -> Vec<DVec3> {
+    let mut pts = vec![];
+    for x in 0..k {
+        for y in 0..k {
+            for z in 0..k {
+                pts.push(DVec3::new(x as f64, y as f64, z as f64));
+            }
+        }
+    }
+    pts
+}
+
+fn sphere(n: usize, seed: u64) -> Vec<DVec3> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    (0..n)
+        .map(|_| loop {
+            let p = DVec3::new(rng.gen(), rng.gen(), rng.gen()) * 2.0 - 1.0;
+            if p.length_squared() > 0.01 && p.length_squared() <= 1.0 {
+                break p.normalize();
+            }
+        })
+        .collect()
+}
+
+fn clustered(n: usize, seed: u64) -> Vec<DVec3> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let centres: Vec<DVec3> = (0..5)
+        .map(|_| DVec3::new(rng.gen(), rng.gen(), rng.gen()))
+        .collect();
+    (0..n)
+        .map(|i| {
+            let c = centres[i % centres.len()];
+            let d = DVec3::new(rng.gen(), rng.gen(), rng.gen()) - 0.5;
+            c + d * 1e-3 * (1.0 + (i % 7) as f64)
+        })
+        .collect()
+}
+
+/// Independent reference: the Delaunay tets of points in general position are exactly the
+/// quadruples whose circumsphere holds no other point (O(n^5); small n only).
+fn brute_force_delaunay_count(pts: &[DVec3]) -> usize {
+    let n = pts.len();
+    let mut count = 0;
+    for a in 0..n {
+        for b in a + 1..n {
+            for c in b + 1..n {
+                for d in c + 1..n {
+                    let (mut p, q, r, s) = (pts[a], pts[b], pts[c], pts[d]);
+                    let mut q = q;
+                    let o = orient3d(p, q, r, s);
+                    if o == 0.0 {
+                        continue;
+                    }
+                    if o < 0.0 {
+                        std::mem::swap(&mut p, &mut q);
+                    }
+                    let empty = (0..n)
+                        .filter(|&e| e != a && e != b && e != c && e != d)
+                        .all(|e| insphere(p, q, r, s, pts[e]) < 0.0);
+                    if empty {
+                        count += 1;
+                    }
+                }
+            }
+        }
+    }
+    count
+}
+
+#[test]
+fn finite_tet_count_matches_brute_force() {
+    for seed in 0..6 {
+        let pts = uniform(18 + seed as usize * 3, seed);
+        let (dt, stats) = Delaunay::from_points(&pts).unwrap();
+        dt.validate().unwrap();
+        assert_eq!(stats.inserted, pts.len());
+        assert_eq!(
+            dt.num_finite_tets(),
+            brute_force_delaunay_count(&pts),
+            "seed {seed}"
+        );
+    }
+}
+
+#[test]
+fn uniform_bulk_is_valid() {
+    let pts = uniform(20_000, 1);
+    let (dt, stats) = Delaunay::from_points(&pts).unwrap();
+    assert_eq!(stats.inserted, 20_000);
+    assert_eq!(dt.num_vertices(), 20_000);
+    dt.validate().unwrap();
+    // Euler-style sanity: about 6.5 tets per point for uniform points in a cube.
+    let ratio = dt.num_finite_tets() as f64 / 20_000.0;
+    assert!((6.0..7.0).contains(&ratio), "tets per point {ratio}");
+}
+
+#[test]
+fn incremental_insertion_is_valid() {
+    let pts = uniform(500, 2);
+    let (mut dt, _) = Delaunay::from_points(&pts).unwrap();
+    for (k, p) in uniform(2000, 3).into_iter().enumerate() {
+        // Spread the new points beyond the hull too.
+        let p = p * 1.5 - 0.25;
+        let r = dt.insert(p, None).unwrap();
+        assert_eq!(r, Inserted::New((500 + k) as u32));
+        if k % 500 == 0 {
+            dt.validate().unwrap();
+        }
+    }
+    dt.validate().unwrap();
+    assert_eq!(dt.num_vertices(), 2500);
+}
+
+#[test]
+fn grid_is_valid() {
+    // Every tet of a grid is cospherical with its neighbours: only the perturbation decides.
+    let pts = grid(12);
+    let (dt, stats) = Delaunay::from_points(&pts).unwrap();
+    dt.validate().unwrap();
+    assert_eq!(stats.inserted, pts.len());
+    // Every tet is inside the cube [0, 11]^3, whose volume is 11^3.
+    let vol: f64 = dt
+        .finite_tets()
+        .map(|t| {
+            let q = t.map(|v| dt.point(v));
+            orient3d(q[0], q[1], q[2], q[3]) / 6.0
+        })
+        .sum();
+    assert!((vol - 1331.0).abs() < 1e-9, "volume {vol}");
+}
+
+#[test]
+fn grid_incremental_in_input_order_is_valid() {
+    // Insert grid points one by one in scanline order: many hull-coplanar insertions.
+    let pts = grid(6);
+    let mut seedpts = vec![pts[0], pts[1], pts[6], pts[36]];
+    let (mut dt, _) = Delaunay::from_points(&seedpts).unwrap();
+    for (i, &p) in pts.iter().enumerate() {
+        if [0, 1, 6, 36].contains(&i) {
+            continue;
+        }
+        dt.insert(p, None).unwrap();
+        seedpts.push(p);
+    }
+    dt.validate().unwrap();
+    assert_eq!(dt.num_vertices(), 216);
+}
+
+#[test]
+fn sphere_points_are_valid() {
+    let pts = sphere(5000, 4);
+    let (dt, _) = Delaunay::from_points(&pts).unwrap();
+    dt.validate().unwrap();
+}
+
+#[test]
+fn clustered_points_are_valid() {
+    let pts = clustered(20_000, 5);
+    let (dt, _) = Delaunay::from_points(&pts).unwrap();
+    dt.validate().unwrap();
+}
+
+#[test]
+fn coplanar_start_is_valid() {
+    // Many coplanar (and collinear) points come first in the input and in any order.
+    let mut pts: Vec<DVec3> = (0..200)
+        .map(|i| DVec3::new((i % 20) as f64, (i / 20) as f64, 0.0))
+        .collect();
+    pts.extend((0..50).map(|i| DVec3::new(i as f64 * 0.5, 0.0, 0.0)));
+    pts.push(DVec3::new(3.3, 4.4, 2.0));
+    pts.push(DVec3::new(7.1, 1.4, -1.5));
+    let (dt, stats) = Delaunay::from_points(&pts).unwrap();
+    dt.validate().unwrap();
+    // (0.5 * even i) duplicates the grid's integer points on the x axis: 20 duplicates.
+    assert_eq!(stats.duplicates, 20);
+    assert_eq!(dt.num_vertices(), pts.len() - 20);
+}
+
+#[test]
+fn degenerate_inputs_are_errors() {
+    let flat: Vec<DVec3> = (0..10)
+        .map(|i| DVec3::new(i as f64, (i * i) as f64, 0.0))
+        .collect();
+    assert!(matches!(
+        Delaunay::from_points(&flat),
+        Err(DelaunayError::Degenerate { .. })
+    ));
+    let line: Vec<DVec3> = (0..10).map(|i| DVec3::splat(i as f64)).collect();
+    assert!(Delaunay::from_points(&line).is_err());
+    assert!(Delaunay::from_points(&[]).is_err());
+    let bad = [DVec3::ZERO, DVec3::X, DVec3::new(f64::NAN, 0.0, 0.0)];
+    match Delaunay::from_points(&bad) {
+        Err(DelaunayError::BadCoordinate { index: 2, .. }) => {}
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn duplicates_are_skipped() {
+    let mut pts = uniform(100, 6);
+    pts.push(pts[10]);
+    pts.push(pts[20]);
+    let (mut dt, stats) = Delaunay::from_points(&pts).unwrap();
+    assert_eq!(stats.duplicates, 2);
+    assert_eq!(dt.num_vertices(), 100);
+    assert_eq!(dt.insert(pts[5], None).unwrap(), Inserted::Duplicate(5));
+    assert_eq!(dt.num_vertex_ids(), 102);
+    dt.validate().unwrap();
+}
+
+#[test]
+fn dry_run_predicts_insertion_and_changes_nothing() {
+    let pts = uniform(3000, 7);
+    let (mut dt, _) = Delaunay::from_points(&pts).unwrap();
+    for p in uniform(50, 8) {
+        let before: Vec<[u32; 4]> = dt.finite_tets().collect();
+        let DryRun::Cavity { removed, faces } = dt.dry_run(p, None) else {
+            panic!("not a duplicate");
+        };
+        assert_eq!(before, dt.finite_tets().collect::<Vec<_>>());
+        let removed_finite = removed.iter().filter(|&&t| dt.is_finite(t)).count();
+        let Inserted::New(id) = dt.insert(p, None).unwrap() else {
+            panic!()
+        };
+        let mut predicted: Vec<[u32; 4]> = faces
+            .iter()
+            .map(|f| [f[0], f[1], f[2], id])
+            .filter(|t| !t.contains(&INFINITE))
+            .map(|mut t| {
+                t.sort_unstable();
+                t
+            })
+            .collect();
+        let mut actual: Vec<[u32; 4]> = dt
+            .finite_tets()
+            .filter(|t| t.contains(&id))
+            .map(|mut t| {
+                t.sort_unstable();
+                t
+            })
+            .collect();
+        predicted.sort_unstable();
+        actual.sort_unstable();
+        assert_eq!(predicted, actual);
+        assert_eq!(
+            before.len() + predicted.len() - removed_finite,
+            dt.num_finite_tets()
+        );
+    }
+    dt.validate().unwrap();
+}
+
+#[test]
+fn new_tets_are_positive_for_faces_from_dry_run() {
+    let pts = uniform(500, 9);
+    let (mut dt, _) = Delaunay::from_points(&pts).unwrap();
+    let p = DVec3::splat(0.5);
+    if let DryRun::Cavity { faces, .. } = dt.dry_run(p, None) {
+        for f in faces.iter().filter(|f| !f.contains(&INFINITE)) {
+            let q = f.map(|v| dt.point(v));
+            assert!(orient3d(q[0], q[1], q[2], p) > 0.0);
+        }
+    }
+}
+
+#[test]
+fn validate_catches_corruption() {
+    let pts = uniform(200, 10);
+    let (dt, _) = Delaunay::from_points(&pts).unwrap();
+    let t = dt.finite_tet_ids().next().unwrap();
+    let mut flipped = dt.clone();
+    flipped.tets[t as usize].v.swap(0, 1);
+    assert!(flipped.validate().unwrap_err().contains("orient"));
+    let mut unlinked = dt.clone();
+    unlinked.tets[t as usize].n[0] = unlinked.tets[t as usize].n[1];
+    assert!(unlinked.validate().is_err());
+    // Moving a vertex slightly breaks the empty-sphere property somewhere.
+    let mut moved = dt.clone();
+    let v = moved.tets[t as usize].v[0];
+    let centre = moved.points.iter().sum::<DVec3>() / 200.0;
+    moved.points[v as usize] = moved.points[v as usize].lerp(centre, 0.3);
+    assert!(moved.validate().is_err());
+}

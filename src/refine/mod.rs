@@ -1,0 +1,152 @@
+//! Li's REMOVE-SLIVER refinement (the paper, section 3) on top of the Delaunay kernel:
+//! boundary recovery (empty encroachment), domain marking, then cleaning of size-bad,
+//! radius-edge-bad and sliver tets from random points of picking regions.
+//!
+//! STUB: the public interface (`Params`, `Spacing`, `Report`, `MeshError`, `mesh`) is fixed;
+//! bodies are being written.
+
+use crate::mesh::TetMesh;
+use crate::plc::PlcInput;
+use glam::DVec3;
+
+/// Refinement parameters (names follow the paper).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Params {
+    /// Radius-edge bound rho0 = R / L (the paper needs > 2 for its proof; 2 works in practice).
+    pub rho0: f64,
+    /// Sliver bound sigma0 = V / L^3 (regular tet: 0.1179).
+    pub sigma0: f64,
+    /// Picking-region radius factor: points are drawn from the ball (c, delta * R).
+    pub delta: f64,
+    /// Small-sliver radius factor: a new sliver with circumradius <= b * R rejects the point.
+    pub b: f64,
+    /// Size factor: a tet with R / f(c) > B is size-bad.
+    pub size_factor: f64,
+    /// Random seed: same input, same parameters, same seed => identical output.
+    pub seed: u64,
+    /// Stop (report `complete: false`) once the mesh has this many vertices.
+    pub max_vertices: usize,
+    /// Candidate points drawn per bad element before the best one is taken.
+    pub max_tries: usize,
+    /// When false, only recover the boundary (no quality refinement).
+    pub refine: bool,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Params {
+            rho0: 2.0,
+            sigma0: 0.02,
+            delta: 0.3,
+            b: 4.0,
+            size_factor: 1.0,
+            seed: 1,
+            max_vertices: 10_000_000,
+            max_tries: 20,
+            refine: true,
+        }
+    }
+}
+
+/// A spacing (target element size) function f(x) > 0.
+pub trait Spacing {
+    fn at(&self, p: DVec3) -> f64;
+    /// Evaluates many points at once (callers across an FFI pay one call per batch).
+    fn at_many(&self, points: &[DVec3], out: &mut [f64]) {
+        for (o, &p) in out.iter_mut().zip(points) {
+            *o = self.at(p);
+        }
+    }
+}
+
+/// Constant spacing.
+#[derive(Debug, Clone, Copy)]
+pub struct ConstantSpacing(pub f64);
+impl Spacing for ConstantSpacing {
+    fn at(&self, _: DVec3) -> f64 {
+        self.0
+    }
+}
+
+/// Spacing from a closure.
+pub struct FnSpacing<F: Fn(DVec3) -> f64>(pub F);
+impl<F: Fn(DVec3) -> f64> Spacing for FnSpacing<F> {
+    fn at(&self, p: DVec3) -> f64 {
+        (self.0)(p)
+    }
+}
+
+/// What a run achieved.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
+pub struct Report {
+    pub n_vertices: usize,
+    pub n_tets: usize,
+    pub n_boundary_faces: usize,
+    pub seconds_recovery: f64,
+    pub seconds_refinement: f64,
+    pub seconds_total: f64,
+    pub max_rho: f64,
+    pub min_sigma: f64,
+    pub min_dihedral_deg: f64,
+    pub max_dihedral_deg: f64,
+    /// Tets with a dihedral angle below 5, 10, 15, 20 degrees.
+    pub tets_below_deg: [usize; 4],
+    /// max over tets of R / f(circumcentre)
+    pub max_size_ratio: f64,
+    /// edge length / f(midpoint): min, median, max
+    pub edge_ratio_min: f64,
+    pub edge_ratio_median: f64,
+    pub edge_ratio_max: f64,
+    /// Acute input angles found (segment pairs < 90 deg, facet pairs < 90 deg).
+    pub n_acute_angles: usize,
+    /// Tets left violating a bound because they are within the influence of an acute angle.
+    pub n_bad_near_acute: usize,
+    /// Whether every bound holds everywhere it is enforced (false when a budget stopped it).
+    pub complete: bool,
+    /// Why refinement stopped early, if it did.
+    pub stop_reason: Option<String>,
+}
+
+/// Why meshing failed.
+#[derive(Debug, Clone, PartialEq)]
+pub enum MeshError {
+    /// The input failed validation; the message names the offending item.
+    InvalidInput(String),
+    /// The spacing function returned a value that is not finite and positive.
+    BadSpacing { point: DVec3, value: f64 },
+    /// The progress callback asked to stop.
+    Cancelled,
+    /// A bug: an internal invariant failed.
+    Internal(String),
+}
+
+impl std::fmt::Display for MeshError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            MeshError::InvalidInput(m) => write!(f, "invalid input: {m}"),
+            MeshError::BadSpacing { point, value } => write!(
+                f,
+                "spacing function returned {value} at ({}, {}, {}): it must be finite and positive",
+                point.x, point.y, point.z
+            ),
+            MeshError::Cancelled => write!(f, "cancelled by the progress callback"),
+            MeshError::Internal(m) => write!(f, "internal error: {m}"),
+        }
+    }
+}
+impl std::error::Error for MeshError {}
+
+/// Progress callback: (fraction done estimate in [0, 1], current vertex count) -> keep going?
+pub type Progress<'a> = &'a mut dyn FnMut(f64, usize) -> bool;
+
+/// Meshes a domain: validation, boundary recovery, marking, and (if `params.refine`) quality
+/// refinement. `spacing` None = automatic (local-feature-size based) spacing.
+pub fn mesh(
+    input: &PlcInput,
+    params: &Params,
+    spacing: Option<&dyn Spacing>,
+    progress: Option<Progress>,
+) -> Result<(TetMesh, Report), MeshError> {
+    let _ = (input, params, spacing, progress);
+    Err(MeshError::Internal("not implemented yet".into()))
+}
