@@ -85,7 +85,8 @@ def table(ours, cgal):
     for label, key, spec in rows:
         a, b = ours.get(key), cgal.get(key)
         ratio = ""
-        if isinstance(a, (int, float)) and isinstance(b, (int, float)) and a:
+        # No ratio for points/s: it would read inverted next to the seconds ratio.
+        if key != "points_per_second" and isinstance(a, (int, float)) and isinstance(b, (int, float)) and a:
             ratio = "%.3f" % (b / a)
         lines.append("%-22s %16s %16s %10s" % (label, fmt(a, spec), fmt(b, spec), ratio))
     if "kernel_bytes_per_tet" in ours:

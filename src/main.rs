@@ -114,7 +114,7 @@ fn run_delaunay(
     }
     if let Some(path) = output {
         tri::write(path, &points, &del)?;
-        println!("wrote           {}", path.display());
+        println!("wrote            {}", path.display());
     }
     Ok(())
 }

@@ -69,22 +69,22 @@ pub fn triangulate(points: &[DVec3]) -> Result<(Delaunay, Stats), String> {
 /// The short human summary printed by `slivermesh delaunay` and the demo.
 pub fn summary(s: &Stats) -> String {
     let mut out = String::new();
-    out += &format!("points          {}\n", s.n_points);
-    out += &format!("vertices        {}\n", s.n_vertices);
+    out += &format!("points           {}\n", s.n_points);
+    out += &format!("vertices         {}\n", s.n_vertices);
     if s.n_duplicates > 0 {
-        out += &format!("duplicates      {} (skipped)\n", s.n_duplicates);
+        out += &format!("duplicates       {} (skipped)\n", s.n_duplicates);
     } else {
-        out += "duplicates      0\n";
+        out += "duplicates       0\n";
     }
-    out += &format!("finite tets     {}\n", s.n_tets);
-    out += &format!("seconds         {:.3} (triangulation only)\n", s.seconds);
-    out += &format!("points/s        {:.0}\n", s.points_per_second);
+    out += &format!("finite tets      {}\n", s.n_tets);
+    out += &format!("seconds          {:.3} (triangulation only)\n", s.seconds);
+    out += &format!("points/s         {:.0}\n", s.points_per_second);
     match (s.peak_rss_mb, s.bytes_per_tet) {
         (Some(mb), Some(bpt)) => {
-            out += &format!("peak RSS        {mb:.1} MB\n");
-            out += &format!("bytes/tet       {bpt:.1} (peak RSS / tets)\n");
+            out += &format!("peak RSS         {mb:.1} MB\n");
+            out += &format!("bytes/tet        {bpt:.1} (peak RSS / tets)\n");
         }
-        _ => out += "peak RSS        unavailable (no /proc/self/status)\n",
+        _ => out += "peak RSS         unavailable (no /proc/self/status)\n",
     }
     out += &format!(
         "kernel bytes/tet {:.1} (triangulation arrays / tets)\n",
