@@ -457,11 +457,11 @@ mod tests {
         expect_err("$MeshFormat\n4.1 1 8\n$EndMeshFormat\n", 2, "binary");
         expect_err("$Nodes\n", 1, "'$MeshFormat' first");
         expect_err("$MeshFormat\n4.1 0 8\n", 3, "unexpected end");
-        expect_err(&good.replace("\n2 1 2 4\n", "\n2 1 2 9\n"), line("\n2 1 2 4\n") + 1, "unknown node tag 9");
+        expect_err(&good.replace("\n4 2 3 5\n", "\n4 2 3 9\n"), line("\n4 2 3 5\n") + 1, "unknown node tag 9");
         expect_err(&good.replace("3 1 4 1\n", "3 1 99 1\n"), line("3 1 4 1\n"), "unknown element type 99");
         expect_err(&good.replace("$EndNodes", "$EndNode"), line("$EndNodes"), "expected '$EndNodes'");
         expect_err(&good.replace("\n2\n3\n", "\n2\n2\n"), line("\n2\n3\n") + 2, "duplicate node tag 2");
-        expect_err(&good.replace("0 1 0 1", "0 1 0 one"), line("0 1 0 1"), "bad number 'one'");
+        expect_err(&good.replace("\n0 1 0\n", "\n0 one 0\n"), line("\n0 1 0\n") + 1, "bad number 'one'");
     }
 
     #[test]

@@ -81,7 +81,7 @@ fn parse_body(
         }
         let mut poly = Vec::with_capacity(super::text::cap(k));
         for _ in 0..k {
-            poly.push(r.index(0, nv, &format!("vertex index of {fname}"))?);
+            poly.push(r.index(0, nv, &format!("{fname}: vertex index"))?);
         }
         plc.facets.push(Facet {
             polygons: vec![poly],
@@ -146,7 +146,7 @@ mod tests {
         expect_err("OFF\n3 1\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", 6, "out of range");
         expect_err("OFF\n3 1\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n", 6, "at least 3");
         expect_err("OFF\n3 2\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", 7, "expected face 2 of 2");
-        expect_err("OFF\n3 1\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n", 6, "expected vertex index");
+        expect_err("OFF\n3 1\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n", 6, "vertex index, found end of line");
         expect_err("OFF\n-3 1\n", 2, "bad non-negative integer '-3'");
     }
 

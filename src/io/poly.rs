@@ -77,10 +77,11 @@ fn read_tetgen_plc(path: &Path, smesh: bool) -> Result<PlcInput, IoError> {
 pub fn parse_node(text: &str) -> Result<NodeList, IoError> {
     let mut lines = Lines::new(text);
     let header = lines.next("node list header '<#points> 3 <#attributes> <#markers>'")?;
-    match parse_node_section(&mut lines, header)? {
-        Some(n) => Ok(n),
-        None => Err(err_at(1, "a .node file must list at least one point")),
-    }
+    // A .node file with 0 points is an empty point set (not a reference to another file).
+    Ok(parse_node_section(&mut lines, header)?.unwrap_or(NodeList {
+        vertices: Vec::new(),
+        base: 1,
+    }))
 }
 
 /// Parses the text of a `.poly` file; `external_nodes` loads the `.node` file when needed.
@@ -168,7 +169,7 @@ fn polygon_indices<'a>(
             line,
             nodes.base,
             n,
-            &format!("vertex index of {what}"),
+            &format!("{what}: vertex index"),
         )?);
     }
     Ok(poly)
@@ -359,13 +360,13 @@ mod tests {
         expect_err("2 3\n1 0 0 0\n2 0 zero 0\n", 3, "bad number 'zero'");
         expect_err("2 3\n1 0 0 0\n2 0 0\n", 3, "expected z coordinate");
         expect_err("2 3\n1 0 0 0\n", 3, "unexpected end of file: expected point 2");
-        expect_err(&format!("{TET}1 0\n1\n3 0 1 4\n0\n"), 7, "out of range");
-        expect_err(&format!("{TET}1 0\n1\n3 0 -1 2\n0\n"), 7, "out of range");
-        expect_err(&format!("{TET}2 0\n1\n3 0 1 2\n"), 8, "expected facet 2");
-        expect_err(&format!("{TET}1 0\n1\n3 0 1\n"), 8, "more corner");
-        expect_err(&format!("{TET}1 0\n0\n0\n"), 6, "0 polygons");
-        expect_err(&format!("{TET}1 0\n1 1\n3 0 1 2\n0 1 1\n0\n"), 8, "expected z");
-        expect_err(&format!("{TET}1 0\n1\n3 0 1 2\n"), 8, "volume hole list");
+        expect_err(&format!("{TET}1 0\n1\n3 0 1 4\n0\n"), 8, "facet 1: vertex index 4 out of range (valid: 0..=3)");
+        expect_err(&format!("{TET}1 0\n1\n3 0 -1 2\n0\n"), 8, "out of range");
+        expect_err(&format!("{TET}2 0\n1\n3 0 1 2\n"), 9, "expected facet 2");
+        expect_err(&format!("{TET}1 0\n1\n3 0 1\n"), 9, "more corner");
+        expect_err(&format!("{TET}1 0\n0\n0\n"), 7, "0 polygons");
+        expect_err(&format!("{TET}1 0\n1 1\n3 0 1 2\n0 1 1\n0\n"), 9, "expected z");
+        expect_err(&format!("{TET}1 0\n1\n3 0 1 2\n"), 9, "volume hole list");
         expect_err(&format!("{TET}0\n0\n1\n0 0 0 0 1.5\n"), 9, "must be an integer");
         expect_err(&format!("{TET}0\n0\n2\n0 0 0 0 1\n"), 10, "region 2 of 2");
         expect_err(&format!("{TET}x\n"), 6, "bad non-negative integer 'x'");

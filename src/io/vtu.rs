@@ -453,10 +453,10 @@ mod tests {
         let line = |pat: &str| line_of(&good, good.find(pat).unwrap());
         expect_err("", Some(1), "not a .vtu");
         expect_err("<VTKFile type=\"PolyData\">", Some(1), "not a VTK UnstructuredGrid");
-        expect_err(&good.replace("0.1 0.2", "0.1 zz"), Some(line("0.1 zz") ), "bad number 'zz'");
+        expect_err(&good.replace("0.1 0.2", "0.1 zz"), Some(line("0.1 0.2")), "bad number 'zz'");
         expect_err(&good.replace("0 1 2 3\n", "0 1 2 9\n"), Some(line("0 1 2 3\n")), "out of range");
         expect_err(&good.replace("0 1 2 3\n", "0 1 2\n"), Some(line("Name=\"connectivity\"")), "has 3 values, expected 4");
-        expect_err(&good.replace(">10\n", ">5\n"), Some(line("Name=\"types\"")), "only tetrahedra");
+        expect_err(&good.replace("\n10\n", "\n5\n"), Some(line("Name=\"types\"")), "only tetrahedra");
         expect_err(&good.replace("format=\"ascii\"", "format=\"binary\""), Some(line("<DataArray")), "ascii only");
         expect_err(&good.replace("NumberOfCells=\"1\"", "NumberOfCells=\"2\""), Some(line("Name=\"types\"")), "expected 2");
         expect_err(&good.replace("0.1 0.2 0.3333333333333333\n", ""), Some(line("Name=\"Points\"")), "has 9 values, expected 12");
