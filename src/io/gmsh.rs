@@ -1,15 +1,16 @@
 //! Gmsh `.msh` version 4.1 ASCII writer, and a reader for the same subset.
 //!
-//! Written (valid per the MSH 4.1 specification, read by gmsh and meshio):
+//! Written (valid per the MSH 4.1 specification; checked with gmsh 4.15 and meshio 5.3):
 //! - `$MeshFormat` `4.1 0 8`.
-//! - `$PhysicalNames`: `3 v "region_v"` for each non-zero tet region attribute v and
-//!   `2 m "marker_m"` for each non-zero boundary marker m (omitted when there are none).
+//! - `$PhysicalNames`: `3 v "region_v"` for each distinct tet region attribute v and
+//!   `2 m "marker_m"` for each distinct boundary marker m.
 //! - `$Entities`: no points or curves; one surface per distinct boundary marker and one volume
 //!   per distinct region attribute (tags 1, 2, ... in order of first appearance; at least one
-//!   volume). Each entity's physical tag is its value, except that the value 0 (regions when
-//!   the input declared none, unmarked facets) gets no physical tag. Entities carry bounding
-//!   boxes and no bounding sub-entities. Gmsh expects positive physical tags: negative
-//!   attributes and markers are written as they are.
+//!   volume). Each entity has exactly one physical tag, the value itself, 0 included (gmsh
+//!   reads a physical group 0; meshio needs every block to have a physical tag). Gmsh treats
+//!   the sign of a physical tag as an orientation, so it folds a negative attribute or marker
+//!   into its absolute value; this module's reader keeps the sign. Entities carry bounding
+//!   boxes and no bounding sub-entities.
 //! - `$Nodes`: one block on volume 1, node tags 1..n in vertex order.
 //! - `$Elements`: one block per entity, tets (type 4) on volumes, triangles (type 2) on
 //!   surfaces. Element tags: tet i is i+1, boundary triangle j is #tets + j + 1, so the order
@@ -89,11 +90,7 @@ fn write_entity<W: Write>(w: &mut W, tag: usize, b: [f64; 6], value: i32) -> std
     for x in b {
         write!(w, " {}", F(x))?;
     }
-    if value == 0 {
-        writeln!(w, " 0 0")
-    } else {
-        writeln!(w, " 1 {value} 0")
-    }
+    writeln!(w, " 1 {value} 0")
 }
 
 /// Writes `mesh` in gmsh 4.1 ASCII format to any writer (the mesh must be consistent).
@@ -113,7 +110,6 @@ pub fn format_msh<W: Write>(w: &mut W, mesh: &TetMesh) -> std::io::Result<()> {
         .iter()
         .map(|e| (3, e.value))
         .chain(surfaces.iter().map(|e| (2, e.value)))
-        .filter(|&(_, v)| v != 0)
         .collect();
     if !names.is_empty() {
         writeln!(w, "$PhysicalNames\n{}", names.len())?;
@@ -162,7 +158,15 @@ pub fn format_msh<W: Write>(w: &mut W, mesh: &TetMesh) -> std::io::Result<()> {
         writeln!(w, "3 {} 4 {}", k + 1, e.elements.len())?;
         for &i in &e.elements {
             let t = mesh.tets[i];
-            writeln!(w, "{} {} {} {} {}", i + 1, t[0] + 1, t[1] + 1, t[2] + 1, t[3] + 1)?;
+            writeln!(
+                w,
+                "{} {} {} {} {}",
+                i + 1,
+                t[0] + 1,
+                t[1] + 1,
+                t[2] + 1,
+                t[3] + 1
+            )?;
         }
     }
     for (k, e) in surfaces.iter().enumerate() {
@@ -269,7 +273,10 @@ pub fn parse_msh(text: &str) -> Result<TetMesh, IoError> {
     let mut tris: Vec<(i64, usize, [i64; 3], i64)> = Vec::new();
     while let Some((line, w)) = tok.next_opt() {
         let Some(name) = w.strip_prefix('$') else {
-            return Err(err_at(line, format!("expected a section ($Name), found '{w}'")));
+            return Err(err_at(
+                line,
+                format!("expected a section ($Name), found '{w}'"),
+            ));
         };
         if !seen_format && name != "MeshFormat" {
             return Err(err_at(line, "expected '$MeshFormat' first"));
@@ -332,9 +339,8 @@ pub fn parse_msh(text: &str) -> Result<TetMesh, IoError> {
                     let entity = super::text::parse_i64(w, l, "entity tag")?;
                     let (l, w) = tok.next("element type")?;
                     let ty = super::text::parse_i64(w, l, "element type")?;
-                    let k = nodes_per_element(ty).ok_or_else(|| {
-                        err_at(l, format!("unknown element type {ty}"))
-                    })?;
+                    let k = nodes_per_element(ty)
+                        .ok_or_else(|| err_at(l, format!("unknown element type {ty}")))?;
                     let n = tok.usize("number of elements in block")?;
                     for _ in 0..n {
                         let (l, tag) = tok.raw_index("element tag")?;
@@ -403,7 +409,8 @@ pub fn parse_msh(text: &str) -> Result<TetMesh, IoError> {
             *d = lookup(s, *l)?;
         }
         mesh.boundary.push(ids);
-        mesh.boundary_markers.push(surf.get(e).copied().unwrap_or(0));
+        mesh.boundary_markers
+            .push(surf.get(e).copied().unwrap_or(0));
     }
     Ok(mesh)
 }
@@ -438,7 +445,13 @@ mod tests {
     fn round_trip_keeps_order_regions_and_markers() {
         let m = two_tets();
         let t = text(&m);
-        assert!(t.contains("$PhysicalNames\n2\n3 5 \"region_5\"\n2 3 \"marker_3\"\n"), "{t}");
+        assert!(
+            t.contains(
+                "$PhysicalNames\n4\n3 0 \"region_0\"\n3 5 \"region_5\"\n\
+                 2 3 \"marker_3\"\n2 0 \"marker_0\"\n"
+            ),
+            "{t}"
+        );
         assert_eq!(parse_msh(&t).unwrap(), m);
     }
 
@@ -457,11 +470,31 @@ mod tests {
         expect_err("$MeshFormat\n4.1 1 8\n$EndMeshFormat\n", 2, "binary");
         expect_err("$Nodes\n", 1, "'$MeshFormat' first");
         expect_err("$MeshFormat\n4.1 0 8\n", 3, "unexpected end");
-        expect_err(&good.replace("\n4 2 3 5\n", "\n4 2 3 9\n"), line("\n4 2 3 5\n") + 1, "unknown node tag 9");
-        expect_err(&good.replace("3 1 4 1\n", "3 1 99 1\n"), line("3 1 4 1\n"), "unknown element type 99");
-        expect_err(&good.replace("$EndNodes", "$EndNode"), line("$EndNodes"), "expected '$EndNodes'");
-        expect_err(&good.replace("\n2\n3\n", "\n2\n2\n"), line("\n2\n3\n") + 2, "duplicate node tag 2");
-        expect_err(&good.replace("\n0 1 0\n", "\n0 one 0\n"), line("\n0 1 0\n") + 1, "bad number 'one'");
+        expect_err(
+            &good.replace("\n4 2 3 5\n", "\n4 2 3 9\n"),
+            line("\n4 2 3 5\n") + 1,
+            "unknown node tag 9",
+        );
+        expect_err(
+            &good.replace("3 1 4 1\n", "3 1 99 1\n"),
+            line("3 1 4 1\n"),
+            "unknown element type 99",
+        );
+        expect_err(
+            &good.replace("$EndNodes", "$EndNode"),
+            line("$EndNodes"),
+            "expected '$EndNodes'",
+        );
+        expect_err(
+            &good.replace("\n2\n3\n", "\n2\n2\n"),
+            line("\n2\n3\n") + 2,
+            "duplicate node tag 2",
+        );
+        expect_err(
+            &good.replace("\n0 1 0\n", "\n0 one 0\n"),
+            line("\n0 1 0\n") + 1,
+            "bad number 'one'",
+        );
     }
 
     #[test]

@@ -185,7 +185,10 @@ pub fn parse_medit(text: &str) -> Result<TetMesh, IoError> {
         .iter()
         .map(|t| [id(t[0]), id(t[1]), id(t[2]), id(t[3])])
         .collect();
-    mesh.boundary = tris.iter().map(|t| [id(t[0]), id(t[1]), id(t[2])]).collect();
+    mesh.boundary = tris
+        .iter()
+        .map(|t| [id(t[0]), id(t[1]), id(t[2])])
+        .collect();
     Ok(mesh)
 }
 
@@ -215,10 +218,26 @@ mod tests {
     #[test]
     fn malformed_medit_files() {
         expect_err("Dimension 3\n", 1, "missing 'MeshVersionFormatted'");
-        expect_err("MeshVersionFormatted 2\nDimension 2\n", 2, "dimension must be 3");
-        expect_err("MeshVersionFormatted 9\n", 1, "unsupported MeshVersionFormatted");
-        expect_err("MeshVersionFormatted 2\nVertices\n2\n0 0 0 0\n", 5, "unexpected end");
-        expect_err("MeshVersionFormatted 2\nVertices\n1\n0 0 x 0\n", 4, "bad number 'x'");
+        expect_err(
+            "MeshVersionFormatted 2\nDimension 2\n",
+            2,
+            "dimension must be 3",
+        );
+        expect_err(
+            "MeshVersionFormatted 9\n",
+            1,
+            "unsupported MeshVersionFormatted",
+        );
+        expect_err(
+            "MeshVersionFormatted 2\nVertices\n2\n0 0 0 0\n",
+            5,
+            "unexpected end",
+        );
+        expect_err(
+            "MeshVersionFormatted 2\nVertices\n1\n0 0 x 0\n",
+            4,
+            "bad number 'x'",
+        );
         expect_err(
             "MeshVersionFormatted 2\nVertices\n1\n0 0 0 0\nTetrahedra\n1\n1 1 1 2 0\n",
             7,
@@ -229,8 +248,16 @@ mod tests {
             7,
             "out of range",
         );
-        expect_err("MeshVersionFormatted 2\nBlobs\n1\n", 2, "unknown or unsupported keyword");
-        expect_err("MeshVersionFormatted 2\nVertices\n-1\n", 3, "bad non-negative integer");
+        expect_err(
+            "MeshVersionFormatted 2\nBlobs\n1\n",
+            2,
+            "unknown or unsupported keyword",
+        );
+        expect_err(
+            "MeshVersionFormatted 2\nVertices\n-1\n",
+            3,
+            "bad non-negative integer",
+        );
     }
 
     #[test]

@@ -143,10 +143,22 @@ mod tests {
         expect_err("OFF BINARY\n", 1, "binary OFF");
         expect_err("OFF\n3 1\n0 0 0\n1 0 0\n", 5, "expected vertex 3 of 3");
         expect_err("OFF\n3 1\n0 0 0\n1 0 0\n0 1 x\n", 5, "bad number 'x'");
-        expect_err("OFF\n3 1\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", 6, "out of range");
+        expect_err(
+            "OFF\n3 1\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n",
+            6,
+            "out of range",
+        );
         expect_err("OFF\n3 1\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n", 6, "at least 3");
-        expect_err("OFF\n3 2\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", 7, "expected face 2 of 2");
-        expect_err("OFF\n3 1\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n", 6, "vertex index, found end of line");
+        expect_err(
+            "OFF\n3 2\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+            7,
+            "expected face 2 of 2",
+        );
+        expect_err(
+            "OFF\n3 1\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n",
+            6,
+            "vertex index, found end of line",
+        );
         expect_err("OFF\n-3 1\n", 2, "bad non-negative integer '-3'");
     }
 

@@ -21,7 +21,9 @@
 //! Not supported: 2D files, `.poly` files with curved-boundary extensions, `.edge`/`.var`/`.mtr`
 //! companions (TetGen's segment constraints, variable constraints, metrics).
 
-use super::text::{err_at, parse_i64, parse_integral_i32, read_text, to_u32, with_path, Lines, Record};
+use super::text::{
+    err_at, parse_i64, parse_integral_i32, read_text, to_u32, with_path, Lines, Record,
+};
 use super::IoError;
 use crate::plc::{Facet, PlcInput, Region};
 use glam::DVec3;
@@ -359,15 +361,31 @@ mod tests {
         expect_err("2 3\n1 0 0 0\n3 0 0 0\n", 3, "out of sequence");
         expect_err("2 3\n1 0 0 0\n2 0 zero 0\n", 3, "bad number 'zero'");
         expect_err("2 3\n1 0 0 0\n2 0 0\n", 3, "expected z coordinate");
-        expect_err("2 3\n1 0 0 0\n", 3, "unexpected end of file: expected point 2");
-        expect_err(&format!("{TET}1 0\n1\n3 0 1 4\n0\n"), 8, "facet 1: vertex index 4 out of range (valid: 0..=3)");
+        expect_err(
+            "2 3\n1 0 0 0\n",
+            3,
+            "unexpected end of file: expected point 2",
+        );
+        expect_err(
+            &format!("{TET}1 0\n1\n3 0 1 4\n0\n"),
+            8,
+            "facet 1: vertex index 4 out of range (valid: 0..=3)",
+        );
         expect_err(&format!("{TET}1 0\n1\n3 0 -1 2\n0\n"), 8, "out of range");
         expect_err(&format!("{TET}2 0\n1\n3 0 1 2\n"), 9, "expected facet 2");
         expect_err(&format!("{TET}1 0\n1\n3 0 1\n"), 9, "more corner");
         expect_err(&format!("{TET}1 0\n0\n0\n"), 7, "0 polygons");
-        expect_err(&format!("{TET}1 0\n1 1\n3 0 1 2\n0 1 1\n0\n"), 9, "expected z");
+        expect_err(
+            &format!("{TET}1 0\n1 1\n3 0 1 2\n0 1 1\n0\n"),
+            9,
+            "expected z",
+        );
         expect_err(&format!("{TET}1 0\n1\n3 0 1 2\n"), 9, "volume hole list");
-        expect_err(&format!("{TET}0\n0\n1\n0 0 0 0 1.5\n"), 9, "must be an integer");
+        expect_err(
+            &format!("{TET}0\n0\n1\n0 0 0 0 1.5\n"),
+            9,
+            "must be an integer",
+        );
         expect_err(&format!("{TET}0\n0\n2\n0 0 0 0 1\n"), 10, "region 2 of 2");
         expect_err(&format!("{TET}x\n"), 6, "bad non-negative integer 'x'");
     }

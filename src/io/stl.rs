@@ -42,9 +42,8 @@ pub fn parse_stl(bytes: &[u8], options: &ReadOptions) -> Result<PlcInput, IoErro
             .collect();
         head == b"solid"
     };
-    let binary_count = (bytes.len() >= 84).then(|| {
-        u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as usize
-    });
+    let binary_count = (bytes.len() >= 84)
+        .then(|| u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as usize);
     let exact_binary = binary_count.is_some_and(|n| binary_size(n) == Some(bytes.len()));
     if exact_binary || !starts_solid {
         parse_binary(bytes, &mut soup)?;
@@ -83,7 +82,11 @@ struct Soup {
 impl Soup {
     fn vertex(&mut self, p: DVec3) -> Result<u32, IoError> {
         // +0.0 normalises -0.0 so that equal coordinates share a key.
-        let key = [(p.x + 0.0).to_bits(), (p.y + 0.0).to_bits(), (p.z + 0.0).to_bits()];
+        let key = [
+            (p.x + 0.0).to_bits(),
+            (p.y + 0.0).to_bits(),
+            (p.z + 0.0).to_bits(),
+        ];
         if let Some(&id) = self.ids.get(&key) {
             return Ok(id);
         }
@@ -296,8 +299,16 @@ mod tests {
         let mut nan = binary(&TET_TRIS, 4);
         nan[84 + 12..84 + 16].copy_from_slice(&f32::NAN.to_le_bytes());
         expect_err(&nan, None, "triangle 1");
-        expect_err(b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n", Some(5), "unexpected end");
-        expect_err(b"solid x\nfacet normal 0 0 1\nouter ring\n", Some(3), "expected 'loop'");
+        expect_err(
+            b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n",
+            Some(5),
+            "unexpected end",
+        );
+        expect_err(
+            b"solid x\nfacet normal 0 0 1\nouter ring\n",
+            Some(3),
+            "expected 'loop'",
+        );
         expect_err(
             b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 q\n",
             Some(4),

@@ -37,7 +37,9 @@ pub fn write_tetgen(path: &Path, mesh: &TetMesh) -> Result<(), IoError> {
     let (node, ele, face) = tetgen_paths(path);
     let write = |p: &Path, f: &dyn Fn(&mut dyn Write) -> std::io::Result<()>| {
         let mut w = create(p)?;
-        f(&mut w).and_then(|_| w.flush()).map_err(|e| write_err(p, e))
+        f(&mut w)
+            .and_then(|_| w.flush())
+            .map_err(|e| write_err(p, e))
     };
     write(&node, &|w| format_node(w, mesh))?;
     write(&ele, &|w| format_ele(w, mesh))?;
@@ -163,11 +165,7 @@ pub fn parse_face(text: &str, nodes: &NodeList, mesh: &mut TetMesh) -> Result<()
         for c in t.iter_mut() {
             *c = r.index(nodes.base, nv, "face vertex index")?;
         }
-        let m = if markers {
-            r.i32("face marker")?
-        } else {
-            0
-        };
+        let m = if markers { r.i32("face marker")? } else { 0 };
         mesh.boundary.push(t);
         mesh.boundary_markers.push(m);
     }
@@ -189,10 +187,7 @@ mod tests {
     #[test]
     fn reads_ten_node_tets_and_float_attributes() {
         let mut m = TetMesh::default();
-        let n = NodeList {
-            base: 0,
-            ..nodes()
-        };
+        let n = NodeList { base: 0, ..nodes() };
         parse_ele("1 10 2\n0 0 1 2 3 0 1 2 3 0 1 -2.0 7\n", &n, &mut m).unwrap();
         assert_eq!(m.tets, vec![[0, 1, 2, 3]]);
         assert_eq!(m.tet_regions, vec![-2]);

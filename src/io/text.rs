@@ -331,7 +331,13 @@ pub(crate) fn parse_integral_i32(w: &str, line: usize, what: &str) -> Result<i32
 }
 
 /// Checks a `base`-based index against `n` vertices; returns the 0-based id.
-pub(crate) fn check_index(v: i64, line: usize, base: usize, n: usize, what: &str) -> Result<u32, IoError> {
+pub(crate) fn check_index(
+    v: i64,
+    line: usize,
+    base: usize,
+    n: usize,
+    what: &str,
+) -> Result<u32, IoError> {
     let lo = base as i64;
     let hi = n as i64 + lo - 1;
     if v < lo || v > hi {
@@ -340,15 +346,18 @@ pub(crate) fn check_index(v: i64, line: usize, base: usize, n: usize, what: &str
         } else {
             format!("valid: {lo}..={hi}")
         };
-        return Err(err_at(
-            line,
-            format!("{what} {v} out of range ({range})"),
-        ));
+        return Err(err_at(line, format!("{what} {v} out of range ({range})")));
     }
     to_u32((v - lo) as usize, line, what)
 }
 
-pub(crate) fn parse_index(w: &str, line: usize, base: usize, n: usize, what: &str) -> Result<u32, IoError> {
+pub(crate) fn parse_index(
+    w: &str,
+    line: usize,
+    base: usize,
+    n: usize,
+    what: &str,
+) -> Result<u32, IoError> {
     let v = parse_i64(w, line, what)?;
     check_index(v, line, base, n, what)
 }

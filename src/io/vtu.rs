@@ -13,7 +13,9 @@
 //! region 0 when it is absent) and every other `CellData` array as a named field. Point data is
 //! ignored. Errors carry the line of the offending array.
 
-use super::text::{check_mesh, create, err_at, err_file, parse_f64, read_text, to_u32, with_path, write_err, F};
+use super::text::{
+    check_mesh, create, err_at, err_file, parse_f64, read_text, to_u32, with_path, write_err, F,
+};
 use super::{CellField, IoError};
 use crate::mesh::TetMesh;
 use glam::DVec3;
@@ -22,7 +24,10 @@ use std::path::Path;
 
 /// Writes `mesh` with `cell_fields` as a `.vtu` file.
 pub fn write_vtu(path: &Path, mesh: &TetMesh, cell_fields: &[CellField]) -> Result<(), IoError> {
-    let lens: Vec<(&str, usize)> = cell_fields.iter().map(|f| (f.name, f.values.len())).collect();
+    let lens: Vec<(&str, usize)> = cell_fields
+        .iter()
+        .map(|f| (f.name, f.values.len()))
+        .collect();
     check_mesh(mesh, &lens).map_err(|e| with_path(e, path))?;
     let mut w = create(path)?;
     format_vtu(&mut w, mesh, cell_fields)
@@ -66,7 +71,11 @@ fn write_rows<W: Write, T>(
 }
 
 /// Writes `mesh` in `.vtu` format to any writer (the mesh and fields must be consistent).
-pub fn format_vtu<W: Write>(w: &mut W, mesh: &TetMesh, cell_fields: &[CellField]) -> std::io::Result<()> {
+pub fn format_vtu<W: Write>(
+    w: &mut W,
+    mesh: &TetMesh,
+    cell_fields: &[CellField],
+) -> std::io::Result<()> {
     let (nv, nt) = (mesh.vertices.len(), mesh.tets.len());
     writeln!(w, "<?xml version=\"1.0\"?>")?;
     writeln!(
@@ -85,21 +94,33 @@ pub fn format_vtu<W: Write>(w: &mut W, mesh: &TetMesh, cell_fields: &[CellField]
         writeln!(w, "{} {} {}", F(p.x), F(p.y), F(p.z))?;
     }
     writeln!(w, "</DataArray>\n</Points>\n<Cells>")?;
-    writeln!(w, "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">")?;
+    writeln!(
+        w,
+        "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">"
+    )?;
     for t in &mesh.tets {
         writeln!(w, "{} {} {} {}", t[0], t[1], t[2], t[3])?;
     }
     writeln!(w, "</DataArray>")?;
-    writeln!(w, "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">")?;
+    writeln!(
+        w,
+        "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">"
+    )?;
     let offsets: Vec<usize> = (1..=nt).map(|i| 4 * i).collect();
     write_rows(w, &offsets, 16, |w, o| write!(w, "{o}"))?;
     writeln!(w, "</DataArray>")?;
-    writeln!(w, "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">")?;
+    writeln!(
+        w,
+        "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">"
+    )?;
     let types = vec![10u8; nt];
     write_rows(w, &types, 32, |w, t| write!(w, "{t}"))?;
     writeln!(w, "</DataArray>\n</Cells>")?;
     writeln!(w, "<CellData Scalars=\"region\">")?;
-    writeln!(w, "<DataArray type=\"Int32\" Name=\"region\" format=\"ascii\">")?;
+    writeln!(
+        w,
+        "<DataArray type=\"Int32\" Name=\"region\" format=\"ascii\">"
+    )?;
     write_rows(w, &mesh.tet_regions, 16, |w, r| write!(w, "{r}"))?;
     writeln!(w, "</DataArray>")?;
     for f in cell_fields {
@@ -254,10 +275,8 @@ fn scan(text: &str) -> Result<(Vec<Array<'_>>, usize, usize), IoError> {
             ("AppendedData", false) => {
                 return Err(err_at(line, "appended (binary) data is not supported"));
             }
-            ("Points" | "Cells" | "CellData" | "PointData", false) => {
-                if !tag.ends_with('/') {
-                    section = name.to_string();
-                }
+            ("Points" | "Cells" | "CellData" | "PointData", false) if !tag.ends_with('/') => {
+                section = name.to_string();
             }
             ("Points" | "Cells" | "CellData" | "PointData", true) => section.clear(),
             ("DataArray", false) => {
@@ -350,7 +369,9 @@ pub fn parse_vtu(text: &str) -> Result<VtuData, IoError> {
         find("Cells", Some(name)).ok_or_else(|| err_file(format!("no Cells '{name}' DataArray")))
     };
     let types_a = cell_array("types")?;
-    let types = numbers(types_a, nc, |w, l| super::text::parse_i64(w, l, "cell type"))?;
+    let types = numbers(types_a, nc, |w, l| {
+        super::text::parse_i64(w, l, "cell type")
+    })?;
     if let Some(i) = types.iter().position(|&t| t != 10) {
         return Err(err_at(
             types_a.line,
@@ -365,7 +386,11 @@ pub fn parse_vtu(text: &str) -> Result<VtuData, IoError> {
     if let Some(i) = (0..nc).find(|&i| offsets[i] != 4 * (i as i64 + 1)) {
         return Err(err_at(
             off_a.line,
-            format!("offset of cell {i} is {}: expected {}", offsets[i], 4 * (i + 1)),
+            format!(
+                "offset of cell {i} is {}: expected {}",
+                offsets[i],
+                4 * (i + 1)
+            ),
         ));
     }
     let conn_a = cell_array("connectivity")?;
@@ -383,7 +408,10 @@ pub fn parse_vtu(text: &str) -> Result<VtuData, IoError> {
         if a.components != 1 {
             return Err(err_at(
                 a.line,
-                format!("cell array '{}' has {} components: only scalars are supported", a.name, a.components),
+                format!(
+                    "cell array '{}' has {} components: only scalars are supported",
+                    a.name, a.components
+                ),
             ));
         }
         if a.name == "region" {
@@ -414,7 +442,12 @@ mod tests {
 
     fn tet_mesh() -> TetMesh {
         TetMesh {
-            vertices: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(0.1, 0.2, 1.0 / 3.0)],
+            vertices: vec![
+                DVec3::ZERO,
+                DVec3::X,
+                DVec3::Y,
+                DVec3::new(0.1, 0.2, 1.0 / 3.0),
+            ],
             tets: vec![[0, 1, 2, 3]],
             tet_regions: vec![-4],
             boundary: vec![],
@@ -432,7 +465,13 @@ mod tests {
     fn round_trip_small_with_odd_field_name() {
         let m = tet_mesh();
         let vals = [f64::NAN];
-        let t = text(&m, &[CellField { name: "a<\"b\">", values: &vals }]);
+        let t = text(
+            &m,
+            &[CellField {
+                name: "a<\"b\">",
+                values: &vals,
+            }],
+        );
         let d = parse_vtu(&t).unwrap();
         assert_eq!(d.mesh, m);
         assert_eq!(d.cell_fields.len(), 1);
@@ -452,19 +491,57 @@ mod tests {
         // Line numbers of the arrays in the writer's layout.
         let line = |pat: &str| line_of(&good, good.find(pat).unwrap());
         expect_err("", Some(1), "not a .vtu");
-        expect_err("<VTKFile type=\"PolyData\">", Some(1), "not a VTK UnstructuredGrid");
-        expect_err(&good.replace("0.1 0.2", "0.1 zz"), Some(line("0.1 0.2")), "bad number 'zz'");
-        expect_err(&good.replace("0 1 2 3\n", "0 1 2 9\n"), Some(line("0 1 2 3\n")), "out of range");
-        expect_err(&good.replace("0 1 2 3\n", "0 1 2\n"), Some(line("Name=\"connectivity\"")), "has 3 values, expected 4");
-        expect_err(&good.replace("\n10\n", "\n5\n"), Some(line("Name=\"types\"")), "only tetrahedra");
-        expect_err(&good.replace("format=\"ascii\"", "format=\"binary\""), Some(line("<DataArray")), "ascii only");
-        expect_err(&good.replace("NumberOfCells=\"1\"", "NumberOfCells=\"2\""), Some(line("Name=\"types\"")), "expected 2");
-        expect_err(&good.replace("0.1 0.2 0.3333333333333333\n", ""), Some(line("Name=\"Points\"")), "has 9 values, expected 12");
+        expect_err(
+            "<VTKFile type=\"PolyData\">",
+            Some(1),
+            "not a VTK UnstructuredGrid",
+        );
+        expect_err(
+            &good.replace("0.1 0.2", "0.1 zz"),
+            Some(line("0.1 0.2")),
+            "bad number 'zz'",
+        );
+        expect_err(
+            &good.replace("0 1 2 3\n", "0 1 2 9\n"),
+            Some(line("0 1 2 3\n")),
+            "out of range",
+        );
+        expect_err(
+            &good.replace("0 1 2 3\n", "0 1 2\n"),
+            Some(line("Name=\"connectivity\"")),
+            "has 3 values, expected 4",
+        );
+        expect_err(
+            &good.replace("\n10\n", "\n5\n"),
+            Some(line("Name=\"types\"")),
+            "only tetrahedra",
+        );
+        expect_err(
+            &good.replace("format=\"ascii\"", "format=\"binary\""),
+            Some(line("<DataArray")),
+            "ascii only",
+        );
+        expect_err(
+            &good.replace("NumberOfCells=\"1\"", "NumberOfCells=\"2\""),
+            Some(line("Name=\"types\"")),
+            "expected 2",
+        );
+        expect_err(
+            &good.replace("0.1 0.2 0.3333333333333333\n", ""),
+            Some(line("Name=\"Points\"")),
+            "has 9 values, expected 12",
+        );
     }
 
     #[test]
     fn truncated_vtu_never_panics() {
-        let good = text(&tet_mesh(), &[CellField { name: "q", values: &[0.5] }]);
+        let good = text(
+            &tet_mesh(),
+            &[CellField {
+                name: "q",
+                values: &[0.5],
+            }],
+        );
         for cut in 0..good.len() {
             let _ = parse_vtu(&good[..cut]);
         }

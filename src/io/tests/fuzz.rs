@@ -21,8 +21,22 @@ impl Rng {
 
 /// Bytes that make parsers take unusual paths.
 const NASTY: &[&[u8]] = &[
-    b"0", b"-1", b"99999999999999999999", b"nan", b"1e999", b"#", b"\n", b" ", b"$End", b"<",
-    b">", b"\"", b"4294967296", b"1.5", b"x", b"\xff",
+    b"0",
+    b"-1",
+    b"99999999999999999999",
+    b"nan",
+    b"1e999",
+    b"#",
+    b"\n",
+    b" ",
+    b"$End",
+    b"<",
+    b">",
+    b"\"",
+    b"4294967296",
+    b"1.5",
+    b"x",
+    b"\xff",
 ];
 
 /// Truncations at up to `cuts` places plus `mutations` random edits, each fed to `parse`.
@@ -76,7 +90,11 @@ fn damaged_domain_files_never_panic() {
     for path in models_in("off", "off") {
         let data = std::fs::read(&path).unwrap();
         // The big models get fewer cuts: each parse with merging is a full pass.
-        let (cuts, muts) = if data.len() > 50_000 { (10, 10) } else { (100, 100) };
+        let (cuts, muts) = if data.len() > 50_000 {
+            (10, 10)
+        } else {
+            (100, 100)
+        };
         hammer(&data, cuts, muts, data.len() as u64, &|b| {
             let _ = off::parse_off(&text(b), &merge);
             let _ = stl::parse_stl(b, &merge);

@@ -61,7 +61,12 @@ fn area(plc: &PlcInput) -> f64 {
 }
 
 fn counts(p: &PlcInput) -> (usize, usize, usize, usize) {
-    (p.vertices.len(), p.facets.len(), p.holes.len(), p.regions.len())
+    (
+        p.vertices.len(),
+        p.facets.len(),
+        p.holes.len(),
+        p.regions.len(),
+    )
 }
 
 #[test]
@@ -94,14 +99,21 @@ fn every_poly_model_reads_with_expected_counts() {
 fn poly_models_details() {
     let cube = read_plc(&model("poly/cube.poly"), &plain()).unwrap();
     assert_eq!(cube.vertices[7], DVec3::ONE);
-    assert_eq!(cube.facets[0].polygons, vec![vec![0, 2, 3, 1]], "1-based ids");
+    assert_eq!(
+        cube.facets[0].polygons,
+        vec![vec![0, 2, 3, 1]],
+        "1-based ids"
+    );
     assert!(cube.facets.iter().all(|f| f.marker == 1));
     assert!((volume(&cube).abs() - 1.0).abs() < 1e-12);
 
     let two = read_plc(&model("poly/two_materials.poly"), &plain()).unwrap();
     let attrs: Vec<i32> = two.regions.iter().map(|r| r.attribute).collect();
     assert_eq!(attrs, vec![1, 2]);
-    assert!(two.regions.iter().all(|r| r.max_size.is_none()), "-1 = no limit");
+    assert!(
+        two.regions.iter().all(|r| r.max_size.is_none()),
+        "-1 = no limit"
+    );
     assert_eq!(two.regions[1].point, DVec3::new(1.5, 0.5, 0.5));
     assert_eq!(two.facets.iter().filter(|f| f.marker == 2).count(), 1);
 
@@ -165,7 +177,10 @@ fn poly_as_smesh_and_with_separate_node_file() {
     assert!(e.path.ends_with("c.node") && e.line == Some(2), "{e}");
     std::fs::remove_file(dir.path("c.node")).unwrap();
     let e = read_plc(&dir.path("c.smesh"), &plain()).unwrap_err();
-    assert!(e.path.ends_with("c.node") && e.message.contains("cannot read"), "{e}");
+    assert!(
+        e.path.ends_with("c.node") && e.message.contains("cannot read"),
+        "{e}"
+    );
 }
 
 fn off_header_counts(path: &std::path::Path) -> (usize, usize) {
@@ -173,8 +188,7 @@ fn off_header_counts(path: &std::path::Path) -> (usize, usize) {
     let mut nums = text
         .lines()
         .map(|l| l.split('#').next().unwrap().trim())
-        .filter(|l| !l.is_empty() && !l.eq_ignore_ascii_case("OFF"))
-        .next()
+        .find(|l| !l.is_empty() && !l.eq_ignore_ascii_case("OFF"))
         .unwrap()
         .split_whitespace()
         .map(|w| w.parse::<usize>().unwrap());
@@ -224,7 +238,10 @@ fn every_off_model_reads_and_merging_keeps_area_and_volume() {
                 }
             }
         }
-        assert!(edges.values().all(|&c| c == 0), "{name}: merged surface not closed");
+        assert!(
+            edges.values().all(|&c| c == 0),
+            "{name}: merged surface not closed"
+        );
     }
 }
 

@@ -47,10 +47,20 @@ pub(crate) fn sample_mesh(n: u32) -> TetMesh {
     // Boundary: the z = 0 and x = n faces, two triangles per square.
     for j in 0..n {
         for i in 0..n {
-            let (a, b, c, d) = (id(i, j, 0), id(i + 1, j, 0), id(i + 1, j + 1, 0), id(i, j + 1, 0));
+            let (a, b, c, d) = (
+                id(i, j, 0),
+                id(i + 1, j, 0),
+                id(i + 1, j + 1, 0),
+                id(i, j + 1, 0),
+            );
             m.boundary.extend([[a, c, b], [a, d, c]]);
             m.boundary_markers.extend([0, 0]);
-            let (a, b, c, d) = (id(n, i, j), id(n, i + 1, j), id(n, i + 1, j + 1), id(n, i, j + 1));
+            let (a, b, c, d) = (
+                id(n, i, j),
+                id(n, i + 1, j),
+                id(n, i + 1, j + 1),
+                id(n, i, j + 1),
+            );
             m.boundary.extend([[a, b, c], [a, c, d]]);
             m.boundary_markers.extend([-7, 42]);
         }
@@ -163,4 +173,64 @@ fn writers_reject_inconsistent_meshes_and_unknown_extensions() {
     assert!(e.message.contains("unsupported mesh format"), "{e}");
     let e = write_mesh(&dir.path("no/such/dir/a.vtu"), &m, &[]).unwrap_err();
     assert!(e.message.contains("cannot write"), "{e}");
+}
+
+/// Writes the sample mesh in every format to `$SLIVERMESH_IO_SAMPLES` for checks by external
+/// readers (meshio, gmsh, VTK): `cargo test --lib write_samples -- --ignored`.
+#[test]
+#[ignore]
+fn write_samples_for_external_readers() {
+    let Ok(dir) = std::env::var("SLIVERMESH_IO_SAMPLES") else {
+        return;
+    };
+    let dir = std::path::PathBuf::from(dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let m = sample_mesh(3);
+    let q: Vec<f64> = (0..m.tets.len()).map(|i| i as f64 / 3.0).collect();
+    let fields = [CellField {
+        name: "quality",
+        values: &q,
+    }];
+    for name in ["sample.vtu", "sample.mesh", "sample.msh", "sample.ele"] {
+        write_mesh(&dir.join(name), &m, &fields).unwrap();
+    }
+}
+
+/// Reads every mesh file in `$SLIVERMESH_IO_SAMPLES` (e.g. files that gmsh or meshio wrote from
+/// the samples) and compares it with the sample mesh: `cargo test --lib read_samples -- --ignored
+/// --nocapture`.
+#[test]
+#[ignore]
+fn read_samples_from_external_writers() {
+    let Ok(dir) = std::env::var("SLIVERMESH_IO_SAMPLES") else {
+        return;
+    };
+    let m = sample_mesh(3);
+    let mut names: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            let ext = p.extension().and_then(|e| e.to_str()).unwrap_or("");
+            ["vtu", "mesh", "msh", "ele"].contains(&ext)
+        })
+        .collect();
+    names.sort();
+    for p in names {
+        match read_mesh(&p) {
+            Ok(r) => eprintln!(
+                "{}: {} vertices (same: {}), {} tets (same: {}), regions same: {}, {} boundary \
+                 (same: {}), markers same: {}",
+                p.display(),
+                r.vertices.len(),
+                r.vertices == m.vertices,
+                r.tets.len(),
+                r.tets == m.tets,
+                r.tet_regions == m.tet_regions,
+                r.boundary.len(),
+                r.boundary == m.boundary,
+                r.boundary_markers == m.boundary_markers
+            ),
+            Err(e) => eprintln!("{e}"),
+        }
+    }
 }
