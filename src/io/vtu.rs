@@ -3,8 +3,11 @@
 //! Written (VTK file version 1.0, ASCII, one `Piece`): `Points` as `Float64` with 3
 //! components; `Cells` with `connectivity` and `offsets` as `Int64` and `types` as `UInt8`
 //! (all 10 = `VTK_TETRA`); `CellData` with `region` (`Int32`, the tet region attribute) and one
-//! `Float64` array per [`CellField`]. Floats are written so they read back bit for bit; a
-//! non-finite field value is written as `nan`, `inf` or `-inf` (VTK 9's parser accepts them).
+//! `Float64` array per [`CellField`]. Floats are written so they read back bit for bit (checked
+//! against VTK 9.7's reader). A non-finite field value (only a degenerate tet has one) is
+//! written as `nan`, `inf` or `-inf`: this module reads them back exactly and VTK 9.7 reads
+//! `nan` and `inf`, but it reads `-inf` as `inf`, and older VTK ASCII parsers may reject such
+//! an array.
 //! Boundary triangles are not written (a `.vtu` holds the tets only: use `.mesh` or `.msh` to
 //! keep boundary markers).
 //!
