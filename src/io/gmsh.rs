@@ -211,7 +211,10 @@ fn expect_end(tok: &mut Tokens, name: &str) -> Result<(), IoError> {
     if w == end {
         Ok(())
     } else {
-        Err(err_at(l, format!("expected '{end}', found '{w}'")))
+        Err(err_at(
+            l,
+            format!("expected '{end}', found '{w}' (is a count in the section wrong?)"),
+        ))
     }
 }
 
@@ -484,6 +487,11 @@ mod tests {
             &good.replace("$EndNodes", "$EndNode"),
             line("$EndNodes"),
             "expected '$EndNodes'",
+        );
+        expect_err(
+            &good.replace("3 1 0 5\n", "3 1 0 4\n"),
+            line("\n0 0 1\n") + 1,
+            "expected '$EndNodes', found '1' (is a count",
         );
         expect_err(
             &good.replace("\n2\n3\n", "\n2\n2\n"),

@@ -163,6 +163,15 @@ pub fn parse_medit(text: &str) -> Result<TetMesh, IoError> {
                         tok.next(&format!("entry of {kw}"))?;
                     }
                 }
+                None if kw.parse::<f64>().is_ok() => {
+                    return Err(err_at(
+                        line,
+                        format!(
+                            "found number '{kw}' where a keyword was expected (is the count of \
+                             the previous section wrong?)"
+                        ),
+                    ))
+                }
                 None => {
                     return Err(err_at(
                         line,
@@ -257,6 +266,11 @@ mod tests {
             "MeshVersionFormatted 2\nVertices\n-1\n",
             3,
             "bad non-negative integer",
+        );
+        expect_err(
+            "MeshVersionFormatted 2\nVertices\n1\n0 0 0 0\n1 1 1 0\n",
+            5,
+            "found number '1' where a keyword was expected",
         );
     }
 

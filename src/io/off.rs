@@ -89,6 +89,7 @@ fn parse_body(
             ..Facet::default()
         });
     }
+    lines.expect_end(&format!("the {nf} faces declared"))?;
     if options.merge_coplanar {
         super::coplanar::merge_coplanar_facets(&mut plc);
     }
@@ -160,6 +161,11 @@ mod tests {
             "vertex index, found end of line",
         );
         expect_err("OFF\n-3 1\n", 2, "bad non-negative integer '-3'");
+        expect_err(
+            "OFF\n3 1\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n# ok\n3 0 1 2\n",
+            8,
+            "unexpected data after the 1 faces declared (is a count wrong?)",
+        );
     }
 
     #[test]

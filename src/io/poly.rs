@@ -80,10 +80,12 @@ pub fn parse_node(text: &str) -> Result<NodeList, IoError> {
     let mut lines = Lines::new(text);
     let header = lines.next("node list header '<#points> 3 <#attributes> <#markers>'")?;
     // A .node file with 0 points is an empty point set (not a reference to another file).
-    Ok(parse_node_section(&mut lines, header)?.unwrap_or(NodeList {
+    let nodes = parse_node_section(&mut lines, header)?.unwrap_or(NodeList {
         vertices: Vec::new(),
         base: 1,
-    }))
+    });
+    lines.expect_end(&format!("the {} points declared", nodes.vertices.len()))?;
+    Ok(nodes)
 }
 
 /// Parses the text of a `.poly` file; `external_nodes` loads the `.node` file when needed.
@@ -280,6 +282,7 @@ fn parse(
                 max_size,
             });
         }
+        lines.expect_end(&format!("the {nr} regions declared"))?;
     }
 
     Ok(PlcInput {
@@ -388,6 +391,14 @@ mod tests {
         );
         expect_err(&format!("{TET}0\n0\n2\n0 0 0 0 1\n"), 10, "region 2 of 2");
         expect_err(&format!("{TET}x\n"), 6, "bad non-negative integer 'x'");
+        expect_err(
+            &format!("{TET}0\n0\n1\n0 0 0 0 1\n1 0 0 0 1\n"),
+            10,
+            "unexpected data after the 1 regions",
+        );
+        let e = parse_node("1 3\n1 0 0 0\n2 0 0 0\n").unwrap_err();
+        assert_eq!(e.line, Some(3), "{e}");
+        assert!(e.message.contains("after the 1 points"), "{e}");
     }
 
     #[test]

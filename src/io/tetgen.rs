@@ -147,7 +147,7 @@ pub fn parse_ele(text: &str, nodes: &NodeList, mesh: &mut TetMesh) -> Result<(),
         mesh.tets.push(t);
         mesh.tet_regions.push(region);
     }
-    Ok(())
+    lines.expect_end(&format!("the {n} tetrahedra declared"))
 }
 
 /// Parses `.face` text into `mesh.boundary` and `mesh.boundary_markers`.
@@ -169,7 +169,7 @@ pub fn parse_face(text: &str, nodes: &NodeList, mesh: &mut TetMesh) -> Result<()
         mesh.boundary.push(t);
         mesh.boundary_markers.push(m);
     }
-    Ok(())
+    lines.expect_end(&format!("the {n} faces declared"))
 }
 
 #[cfg(test)]
@@ -219,6 +219,8 @@ mod tests {
         face_err("1 1\n1 1 2 3\n", 2, "expected face marker");
         face_err("1 1\n1 1 2 0 4\n", 2, "out of range");
         face_err("1 1\n1 1 2 x 4\n", 2, "bad integer 'x'");
+        ele_err("1 4 0\n1 1 2 3 4\n2 1 2 3 4\n", 3, "after the 1 tetrahedra");
+        face_err("1 0\n1 1 2 3\n2 1 2 4\n", 3, "after the 1 faces");
     }
 
     #[test]

@@ -127,6 +127,18 @@ impl<'a> Lines<'a> {
         }
     }
 
+    /// Checks that nothing but comments and blank lines follows: extra records usually mean a
+    /// count in the file is wrong.
+    pub(crate) fn expect_end(&mut self, after: &str) -> Result<(), IoError> {
+        match self.next_opt() {
+            None => Ok(()),
+            Some(r) => Err(err_at(
+                r.line,
+                format!("unexpected data after {after} (is a count wrong?)"),
+            )),
+        }
+    }
+
     /// An "unexpected end of file" error, reported at the line after the last record read.
     pub(crate) fn eof(&self, what: &str) -> IoError {
         err_at(
