@@ -23,7 +23,9 @@
 //! tag. `$PhysicalNames` and any other section are skipped. Not supported: binary files,
 //! MSH 2.x and 4.0, high-order tets (their blocks are read past).
 
-use super::text::{check_mesh, create, err_at, read_text, with_path, write_err, Tokens, F};
+use super::text::{
+    check_mesh, check_mesh_io, create, err_at, read_text, with_path, write_err, Tokens, F,
+};
 use super::IoError;
 use crate::mesh::TetMesh;
 use glam::DVec3;
@@ -93,8 +95,10 @@ fn write_entity<W: Write>(w: &mut W, tag: usize, b: [f64; 6], value: i32) -> std
     writeln!(w, " 1 {value} 0")
 }
 
-/// Writes `mesh` in gmsh 4.1 ASCII format to any writer (the mesh must be consistent).
+/// Writes `mesh` in gmsh 4.1 ASCII format to any writer.
+/// An inconsistent mesh is an `InvalidInput` error.
 pub fn format_msh<W: Write>(w: &mut W, mesh: &TetMesh) -> std::io::Result<()> {
+    check_mesh_io(mesh, &[])?;
     let (nv, nt, nb) = (mesh.vertices.len(), mesh.tets.len(), mesh.boundary.len());
     let mut volumes = group(&mesh.tet_regions);
     if volumes.is_empty() {

@@ -14,7 +14,8 @@
 //! is not supported.
 
 use super::text::{
-    check_index, check_mesh, create, err_at, read_text, to_u32, with_path, write_err, Tokens, F,
+    check_index, check_mesh, check_mesh_io, create, err_at, read_text, to_u32, with_path,
+    write_err, Tokens, F,
 };
 use super::IoError;
 use crate::mesh::TetMesh;
@@ -30,8 +31,10 @@ pub fn write_medit(path: &Path, mesh: &TetMesh) -> Result<(), IoError> {
         .map_err(|e| write_err(path, e))
 }
 
-/// Writes `mesh` in medit format to any writer (the mesh must be consistent).
+/// Writes `mesh` in medit format to any writer.
+/// An inconsistent mesh is an `InvalidInput` error.
 pub fn format_medit<W: Write>(w: &mut W, mesh: &TetMesh) -> std::io::Result<()> {
+    check_mesh_io(mesh, &[])?;
     writeln!(w, "MeshVersionFormatted 2\n\nDimension 3\n")?;
     writeln!(w, "Vertices\n{}", mesh.vertices.len())?;
     for p in &mesh.vertices {

@@ -15,7 +15,8 @@
 
 use super::poly::{parse_node, NodeList};
 use super::text::{
-    check_mesh, create, err_at, parse_integral_i32, read_text, with_path, write_err, Lines, F,
+    check_mesh, check_mesh_io, create, err_at, parse_integral_i32, read_text, with_path, write_err,
+    Lines, F,
 };
 use super::IoError;
 use crate::mesh::TetMesh;
@@ -46,8 +47,10 @@ pub fn write_tetgen(path: &Path, mesh: &TetMesh) -> Result<(), IoError> {
     write(&face, &|w| format_face(w, mesh))
 }
 
-/// Writes the `.node` part (the mesh must be consistent).
+/// Writes the `.node` part.
+/// An inconsistent mesh is an `InvalidInput` error.
 pub fn format_node(w: &mut dyn Write, mesh: &TetMesh) -> std::io::Result<()> {
+    check_mesh_io(mesh, &[])?;
     writeln!(w, "{} 3 0 0", mesh.vertices.len())?;
     for (i, p) in mesh.vertices.iter().enumerate() {
         writeln!(w, "{} {} {} {}", i + 1, F(p.x), F(p.y), F(p.z))?;
@@ -55,8 +58,10 @@ pub fn format_node(w: &mut dyn Write, mesh: &TetMesh) -> std::io::Result<()> {
     writeln!(w, "# written by slivermesh")
 }
 
-/// Writes the `.ele` part (the mesh must be consistent).
+/// Writes the `.ele` part.
+/// An inconsistent mesh is an `InvalidInput` error.
 pub fn format_ele(w: &mut dyn Write, mesh: &TetMesh) -> std::io::Result<()> {
+    check_mesh_io(mesh, &[])?;
     writeln!(w, "{} 4 1", mesh.tets.len())?;
     for (i, (t, r)) in mesh.tets.iter().zip(&mesh.tet_regions).enumerate() {
         writeln!(
@@ -72,8 +77,10 @@ pub fn format_ele(w: &mut dyn Write, mesh: &TetMesh) -> std::io::Result<()> {
     writeln!(w, "# written by slivermesh")
 }
 
-/// Writes the `.face` part (the mesh must be consistent).
+/// Writes the `.face` part.
+/// An inconsistent mesh is an `InvalidInput` error.
 pub fn format_face(w: &mut dyn Write, mesh: &TetMesh) -> std::io::Result<()> {
+    check_mesh_io(mesh, &[])?;
     writeln!(w, "{} 1", mesh.boundary.len())?;
     for (i, (t, m)) in mesh.boundary.iter().zip(&mesh.boundary_markers).enumerate() {
         writeln!(w, "{} {} {} {} {m}", i + 1, t[0] + 1, t[1] + 1, t[2] + 1)?;

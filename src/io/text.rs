@@ -396,6 +396,12 @@ impl fmt::Display for F {
     }
 }
 
+/// [`check_mesh`] for the `format_*` functions, which return `std::io::Error`.
+pub(crate) fn check_mesh_io(mesh: &TetMesh, field_lens: &[(&str, usize)]) -> std::io::Result<()> {
+    check_mesh(mesh, field_lens)
+        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidInput, e.message))
+}
+
 /// Checks that a mesh is self-consistent before writing it, so writers never index out of range.
 pub(crate) fn check_mesh(mesh: &TetMesh, field_lens: &[(&str, usize)]) -> Result<(), IoError> {
     let bad = |m: String| err_file(format!("cannot write an inconsistent mesh: {m}"));

@@ -17,7 +17,8 @@
 //! ignored. Errors carry the line of the offending array.
 
 use super::text::{
-    check_mesh, create, err_at, err_file, parse_f64, read_text, to_u32, with_path, write_err, F,
+    check_mesh, check_mesh_io, create, err_at, err_file, parse_f64, read_text, to_u32, with_path,
+    write_err, F,
 };
 use super::{CellField, IoError};
 use crate::mesh::TetMesh;
@@ -73,12 +74,18 @@ fn write_rows<W: Write, T>(
     Ok(())
 }
 
-/// Writes `mesh` in `.vtu` format to any writer (the mesh and fields must be consistent).
+/// Writes `mesh` in `.vtu` format to any writer.
+/// An inconsistent mesh is an `InvalidInput` error.
 pub fn format_vtu<W: Write>(
     w: &mut W,
     mesh: &TetMesh,
     cell_fields: &[CellField],
 ) -> std::io::Result<()> {
+    let lens: Vec<(&str, usize)> = cell_fields
+        .iter()
+        .map(|f| (f.name, f.values.len()))
+        .collect();
+    check_mesh_io(mesh, &lens)?;
     let (nv, nt) = (mesh.vertices.len(), mesh.tets.len());
     writeln!(w, "<?xml version=\"1.0\"?>")?;
     writeln!(
@@ -352,6 +359,9 @@ fn numbers<T>(
 /// Parses the text of a `.vtu` file.
 pub fn parse_vtu(text: &str) -> Result<VtuData, IoError> {
     let (arrays, np, nc) = scan(text)?;
+    if u32::try_from(nc).is_err() {
+        return Err(err_file(format!("{nc} cells exceed the 32-bit id range")));
+    }
     let find = |section: &str, name: Option<&str>| {
         arrays
             .iter()

@@ -149,6 +149,11 @@ fn writers_reject_inconsistent_meshes_and_unknown_extensions() {
         assert!(e.message.contains("tet 0"), "{e}");
         assert!(!dir.path(name).exists(), "nothing written for {name}");
     }
+    let mut sink = Vec::new();
+    assert!(crate::io::gmsh::format_msh(&mut sink, &m).is_err());
+    assert!(crate::io::medit::format_medit(&mut sink, &m).is_err());
+    assert!(crate::io::tetgen::format_ele(&mut sink, &m).is_err());
+    assert!(vtu::format_vtu(&mut sink, &m, &[]).is_err());
     let m = sample_mesh(1);
     let short = [1.0];
     let e = write_mesh(
