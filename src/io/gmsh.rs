@@ -275,9 +275,9 @@ pub fn parse_msh(text: &str) -> Result<TetMesh, IoError> {
     let mut seen_format = false;
     let (mut surf, mut vol) = (Physicals::default(), Physicals::default());
     let mut nodes: Vec<(i64, usize, DVec3)> = Vec::new();
-    // (element tag, line, node tags, entity tag)
-    let mut tets: Vec<(i64, usize, [i64; 4], i64)> = Vec::new();
-    let mut tris: Vec<(i64, usize, [i64; 3], i64)> = Vec::new();
+    // (element tag, line, node tags, (entity dimension, entity tag))
+    let mut tets: Vec<(i64, usize, [i64; 4], (usize, i64))> = Vec::new();
+    let mut tris: Vec<(i64, usize, [i64; 3], (usize, i64))> = Vec::new();
     while let Some((line, w)) = tok.next_opt() {
         let Some(name) = w.strip_prefix('$') else {
             return Err(err_at(
@@ -341,9 +341,9 @@ pub fn parse_msh(text: &str) -> Result<TetMesh, IoError> {
                 tok.usize("minimum element tag")?;
                 tok.usize("maximum element tag")?;
                 for _ in 0..blocks {
-                    tok.usize("entity dimension")?;
+                    let dim = tok.usize("entity dimension")?;
                     let (l, w) = tok.next("entity tag")?;
-                    let entity = super::text::parse_i64(w, l, "entity tag")?;
+                    let entity = (dim, super::text::parse_i64(w, l, "entity tag")?);
                     let (l, w) = tok.next("element type")?;
                     let ty = super::text::parse_i64(w, l, "element type")?;
                     let k = nodes_per_element(ty)
@@ -396,6 +396,15 @@ pub fn parse_msh(text: &str) -> Result<TetMesh, IoError> {
             .copied()
             .ok_or_else(|| err_at(line, format!("element refers to unknown node tag {tag}")))
     };
+    // First physical tag of an element's entity; 0 when it has none.
+    let physical = |(dim, tag): (usize, i64)| {
+        let map = match dim {
+            2 => &surf,
+            3 => &vol,
+            _ => return 0,
+        };
+        map.get(&tag).copied().unwrap_or(0)
+    };
     let mut mesh = TetMesh {
         vertices: nodes.iter().map(|n| n.2).collect(),
         ..TetMesh::default()
@@ -407,7 +416,7 @@ pub fn parse_msh(text: &str) -> Result<TetMesh, IoError> {
             *d = lookup(s, *l)?;
         }
         mesh.tets.push(ids);
-        mesh.tet_regions.push(vol.get(e).copied().unwrap_or(0));
+        mesh.tet_regions.push(physical(*e));
     }
     tris.sort_by_key(|t| t.0);
     for (_, l, t, e) in &tris {
@@ -416,8 +425,7 @@ pub fn parse_msh(text: &str) -> Result<TetMesh, IoError> {
             *d = lookup(s, *l)?;
         }
         mesh.boundary.push(ids);
-        mesh.boundary_markers
-            .push(surf.get(e).copied().unwrap_or(0));
+        mesh.boundary_markers.push(physical(*e));
     }
     Ok(mesh)
 }

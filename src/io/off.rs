@@ -39,17 +39,21 @@ pub fn parse_off(text: &str, options: &ReadOptions) -> Result<PlcInput, IoError>
             format!("expected 'OFF' header, found '{kw}'"),
         ));
     }
-    let mut counts = r;
-    if let Some(w) = counts.word_opt() {
-        if w.eq_ignore_ascii_case("BINARY") {
-            return Err(err_at(counts.line, "binary OFF is not supported"));
+    // The counts follow on the header line or on the next record.
+    let (mut counts, nv) = match r.word_opt() {
+        Some(w) if w.eq_ignore_ascii_case("BINARY") => {
+            return Err(err_at(r.line, "binary OFF is not supported"));
         }
-        // Counts on the header line: re-read this line's remaining fields from `w`.
-        let nv = super::text::parse_usize(w, counts.line, "number of vertices")?;
-        return parse_body(&mut lines, nv, &mut counts, options);
-    }
-    let mut counts = lines.next("counts '<#vertices> <#faces> <#edges>'")?;
-    let nv = counts.usize("number of vertices")?;
+        Some(w) => {
+            let nv = super::text::parse_usize(w, r.line, "number of vertices")?;
+            (r, nv)
+        }
+        None => {
+            let mut c = lines.next("counts '<#vertices> <#faces> <#edges>'")?;
+            let nv = c.usize("number of vertices")?;
+            (c, nv)
+        }
+    };
     parse_body(&mut lines, nv, &mut counts, options)
 }
 
