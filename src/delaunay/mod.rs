@@ -279,6 +279,12 @@ impl Delaunay {
     pub fn set_tag(&mut self, t: u32, tag: u32) {
         self.tags[t as usize] = tag;
     }
+    /// A finite tet whose closure contains `p`, or a hull tet with `p` beyond its hull face.
+    pub fn locate_point(&mut self, p: DVec3, hint: Option<u32>) -> u32 {
+        let hint = hint.filter(|&t| self.is_alive(t)).unwrap_or(self.last);
+        self.locate(p, hint)
+    }
+
     /// Tets created by the last successful insertion (all incident to the new vertex).
     pub fn last_created(&self) -> &[u32] {
         &self.scratch.created
