@@ -105,6 +105,9 @@ def main():
     ap.add_argument("--kind", default="uniform", choices=["uniform", "grid", "sphere", "clustered"])
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--points", help="use this point file instead of generating one")
+    ap.add_argument("--general-position", action="store_true",
+                    help="with --points: the file is in general position (e.g. written by "
+                         "gen-points --kind uniform), so check tet counts and checksums too")
     ap.add_argument("--repeat", type=int, default=1, help="runs per program; the fastest is reported")
     ap.add_argument("--no-checksum", action="store_true",
                     help="skip CGAL's second (untimed) triangulation that computes the tet checksum")
@@ -162,7 +165,8 @@ def main():
         if ours["n_vertices"] != cgal["n_vertices"]:
             failures.append("vertex counts differ: slivermesh %d, CGAL %d"
                             % (ours["n_vertices"], cgal["n_vertices"]))
-        general_position = args.points is None and args.kind != "grid"
+        general_position = (args.general_position if args.points
+                            else args.kind != "grid")
         if general_position:
             if ours["n_tets"] != cgal["n_tets"]:
                 failures.append("finite tet counts differ: slivermesh %d, CGAL %d "

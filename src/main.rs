@@ -105,9 +105,12 @@ fn run_delaunay(
     output: Option<&std::path::Path>,
     stats_json: Option<&std::path::Path>,
 ) -> Result<(), String> {
+    let t0 = std::time::Instant::now();
     let points = slivermesh::io::points::read_points(points_path).map_err(|e| e.to_string())?;
-    let (del, stats) = tri::triangulate(&points)
+    let read_seconds = t0.elapsed().as_secs_f64();
+    let (del, mut stats) = tri::triangulate(&points)
         .map_err(|e| format!("{}: cannot triangulate: {e}", points_path.display()))?;
+    stats.read_seconds = Some(read_seconds);
     print!("{}", tri::summary(&stats));
     if let Some(path) = stats_json {
         tri::write_stats_json(path, &stats)?;

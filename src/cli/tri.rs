@@ -30,6 +30,9 @@ pub struct Stats {
     /// Order-independent checksum of the set of finite tets (see [`tets_checksum`]), as 16 hex
     /// digits; equal checksums mean (with overwhelming probability) equal triangulations.
     pub tets_checksum: String,
+    /// Seconds spent reading the point file (`slivermesh delaunay` only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub read_seconds: Option<f64>,
 }
 
 /// Triangulates `points`, timing only `Delaunay::from_points`.
@@ -62,6 +65,7 @@ pub fn triangulate(points: &[DVec3]) -> Result<(Delaunay, Stats), String> {
         kernel_bytes,
         kernel_bytes_per_tet: per_tet(kernel_bytes as f64),
         tets_checksum: format!("{:016x}", tets_checksum(del.finite_tets())),
+        read_seconds: None,
     };
     Ok((del, stats))
 }
@@ -69,7 +73,10 @@ pub fn triangulate(points: &[DVec3]) -> Result<(Delaunay, Stats), String> {
 /// The short human summary printed by `slivermesh delaunay` and the demo.
 pub fn summary(s: &Stats) -> String {
     let mut out = String::new();
-    out += &format!("points           {}\n", s.n_points);
+    match s.read_seconds {
+        Some(r) => out += &format!("points           {} (read in {r:.3} s)\n", s.n_points),
+        None => out += &format!("points           {}\n", s.n_points),
+    }
     out += &format!("vertices         {}\n", s.n_vertices);
     if s.n_duplicates > 0 {
         out += &format!("duplicates       {} (skipped)\n", s.n_duplicates);
@@ -182,6 +189,7 @@ mod tests {
             kernel_bytes: 2000,
             kernel_bytes_per_tet: 100.0,
             tets_checksum: "0".into(),
+            read_seconds: Some(0.25),
         };
         let text = summary(&s);
         for needle in [
