@@ -150,8 +150,9 @@ pub enum PlcError {
     EmptyDomain,
 }
 
+/// Debug formatting of f64 keeps huge and tiny values short (1e31, not 31 digits).
 fn fmt_point(p: DVec3) -> String {
-    format!("({}, {}, {})", p.x, p.y, p.z)
+    format!("({:?}, {:?}, {:?})", p.x, p.y, p.z)
 }
 
 impl fmt::Display for PlcError {

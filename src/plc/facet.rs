@@ -13,7 +13,7 @@ use super::exact::{orient2d, segments_meet_2d, shared_end_overlap_2d, P2};
 use super::plane::{fit_plane, Plane};
 use super::Facet;
 use glam::DVec3;
-use rustc_hash::FxHashMap;
+use rustc_hash::{FxHashMap, FxHashSet};
 use spade::handles::{FixedDirectedEdgeHandle, FixedFaceHandle, FixedVertexHandle, InnerTag};
 use spade::{ConstrainedDelaunayTriangulation, Point2, PositionInTriangulation, Triangulation};
 use std::cmp::Ordering;
@@ -304,16 +304,17 @@ fn shared_endpoint(e: &LocalEdge, f: &LocalEdge) -> Option<(usize, usize, usize)
 
 /// Floods `outside` from `seeds` across edges that are not polygon edges.
 type Face = FixedFaceHandle<InnerTag>;
+type Edge<'a> = spade::handles::DirectedEdgeHandle<'a, Point2<f64>, (), spade::CdtEdge<()>, ()>;
 
-/// Marks `seeds` outside and floods from them across edges that are not polygon edges.
-fn flood(cdt: &Cdt, outside: &mut [bool], seeds: Vec<Face>) {
+/// Marks `seeds` outside and floods from them across edges that are not barriers.
+fn flood(cdt: &Cdt, outside: &mut [bool], seeds: Vec<Face>, barrier: &dyn Fn(Edge) -> bool) {
     for f in &seeds {
         outside[f.index()] = true;
     }
     let mut stack = seeds;
     while let Some(f) = stack.pop() {
         for e in cdt.face(f).adjacent_edges() {
-            if e.as_undirected().is_constraint_edge() {
+            if barrier(e) {
                 continue;
             }
             if let Some(g) = e.rev().face().as_inner() {
@@ -348,18 +349,34 @@ fn classify_faces(
 ) -> Result<Vec<bool>, PlcError> {
     let mut outside = vec![false; cdt.num_all_faces()];
     outside[0] = true;
-    // 1. Everything reachable from beyond the convex hull.
+    // 1. Everything reachable from beyond the convex hull without crossing an outer polygon
+    //    (hole polygons are no barrier yet, so a hole outside the outer polygons shows).
+    let outer_edges: FxHashSet<(usize, usize)> = polygons
+        .iter()
+        .filter(|(r, _)| r.kind == PolygonKind::Outer)
+        .flat_map(|(_, p)| {
+            (0..p.len()).map(|i| {
+                let (a, b) = (local[&p[i]], local[&p[(i + 1) % p.len()]]);
+                (a.min(b), a.max(b))
+            })
+        })
+        .collect();
+    let outer_barrier = |e: Edge| {
+        let (a, b) = (e.from().fix().index(), e.to().fix().index());
+        outer_edges.contains(&(a.min(b), a.max(b)))
+    };
+    let any_barrier = |e: Edge| e.as_undirected().is_constraint_edge();
     let mut seeds = Vec::new();
     for f in cdt.inner_faces() {
         let hull_side = f
             .adjacent_edges()
             .iter()
-            .any(|e| e.rev().face().is_outer() && !e.as_undirected().is_constraint_edge());
+            .any(|&e| e.rev().face().is_outer() && !outer_barrier(e));
         if hull_side {
             seeds.push(f.fix());
         }
     }
-    flood(cdt, &mut outside, seeds);
+    flood(cdt, &mut outside, seeds, &outer_barrier);
 
     // 2. Inside each hole polygon; each must lie in what the outer polygons cover.
     let mut seeds = Vec::new();
@@ -375,7 +392,7 @@ fn classify_faces(
             }
         }
     }
-    flood(cdt, &mut outside, seeds);
+    flood(cdt, &mut outside, seeds, &any_barrier);
 
     // 3. Hole points, all located before any is flooded (several may share a hole).
     let mut seeds = Vec::new();
@@ -414,7 +431,7 @@ fn classify_faces(
             }
         }
     }
-    flood(cdt, &mut outside, seeds);
+    flood(cdt, &mut outside, seeds, &any_barrier);
     Ok(outside)
 }
 

@@ -198,3 +198,6 @@ fn check_duplicates(vertices: &[DVec3]) -> Result<(), PlcError> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests;

@@ -130,15 +130,15 @@ fn symmetric_eigen(m: DMat3) -> ([f64; 3], [DVec3; 3]) {
             let c = 1.0 / (t * t + 1.0).sqrt();
             let s = t * c;
             // A <- J^T A J with the rotation J in the (p, q) plane.
-            for k in 0..3 {
-                let (akp, akq) = (a[k][p], a[k][q]);
-                a[k][p] = c * akp - s * akq;
-                a[k][q] = s * akp + c * akq;
+            for ak in a.iter_mut() {
+                let (akp, akq) = (ak[p], ak[q]);
+                ak[p] = c * akp - s * akq;
+                ak[q] = s * akp + c * akq;
             }
+            let (ap, aq) = (a[p], a[q]);
             for k in 0..3 {
-                let (apk, aqk) = (a[p][k], a[q][k]);
-                a[p][k] = c * apk - s * aqk;
-                a[q][k] = s * apk + c * aqk;
+                a[p][k] = c * ap[k] - s * aq[k];
+                a[q][k] = s * ap[k] + c * aq[k];
             }
             for vk in v.iter_mut() {
                 let (vp, vq) = (vk[p], vk[q]);
@@ -186,9 +186,9 @@ mod tests {
         // A square in the plane y = 0 wound so its normal is -y.
         let pts = [
             DVec3::new(0.0, 0.0, 0.0),
-            DVec3::new(0.0, 0.0, 1.0),
-            DVec3::new(1.0, 0.0, 1.0),
             DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 1.0),
+            DVec3::new(0.0, 0.0, 1.0),
         ];
         let fit = fit_plane(&pts, &pts);
         assert_eq!(fit.plane.axis, 1);
