@@ -107,6 +107,14 @@ pub enum PlcError {
         hole: usize,
         point: DVec3,
     },
+    /// A facet hole point is not finite or lies off the facet's plane (beyond the planarity
+    /// tolerance): it probably belongs to another facet.
+    HolePointOffPlane {
+        facet: usize,
+        hole: usize,
+        point: DVec3,
+        distance: f64,
+    },
     /// A facet hole point lies on a polygon edge or vertex, so it marks no side.
     HolePointOnEdge {
         facet: usize,
@@ -228,6 +236,16 @@ impl fmt::Display for PlcError {
             HolePointOutsideFacet { facet, hole, point } => write!(
                 f,
                 "facet {facet}: hole point {hole} at {} is not inside the facet",
+                fmt_point(*point)
+            ),
+            HolePointOffPlane {
+                facet,
+                hole,
+                point,
+                distance,
+            } => write!(
+                f,
+                "facet {facet}: hole point {hole} at {} is {distance:e} off the facet's plane",
                 fmt_point(*point)
             ),
             HolePointOnEdge { facet, hole, point } => write!(

@@ -12,6 +12,7 @@ use super::error::{PlcError, PolygonKind, PolygonRef};
 use super::exact::{orient2d, segments_meet_2d, shared_end_overlap_2d, P2};
 use super::plane::{fit_plane, Plane};
 use super::Facet;
+use crate::geom::check_coordinate;
 use glam::DVec3;
 use rustc_hash::{FxHashMap, FxHashSet};
 use spade::handles::{FixedDirectedEdgeHandle, FixedFaceHandle, FixedVertexHandle, InnerTag};
@@ -169,6 +170,18 @@ pub fn build_facet(k: usize, facet: &Facet, vertices: &[DVec3]) -> Result<PlcFac
     .expect("coordinates were range-checked before triangulation");
     debug_assert_eq!(cdt.num_vertices(), p2.len());
 
+    for (h, &point) in facet.hole_points.iter().enumerate() {
+        let distance = plane.distance(point).abs();
+        // NaN fails this test too, before it could reach the point location.
+        if !(distance <= fit.tolerance) || check_coordinate(point).is_err() {
+            return Err(PlcError::HolePointOffPlane {
+                facet: k,
+                hole: h,
+                point,
+                distance,
+            });
+        }
+    }
     let outside = classify_faces(k, facet, &polygons, &cdt, &p2, &local, &plane)?;
     let (loops, interior_edges) = boundary_loops(&cdt, &edges, &outside, &global, &p2)?;
 

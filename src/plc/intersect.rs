@@ -80,25 +80,36 @@ fn sweep_axis(boxes: &[(DVec3, DVec3)]) -> usize {
 }
 
 /// A vertex that belongs to no facet must not lie on one: the facet's triangulation could
-/// not contain it. (Such vertices are few; a linear scan per vertex is enough.)
+/// not contain it. Points sorted by x; each triangle tests only the points in its x-range.
 pub(crate) fn check_isolated_vertices(
     vertices: &[DVec3],
     isolated: &[u32],
     topo: &Topology,
 ) -> Result<(), PlcError> {
-    for &v in isolated {
-        let p = vertices[v as usize];
-        for &(f, _, t) in &topo.tris {
-            let [a, b, c] = t.map(|i| vertices[i as usize]);
-            let inside_box = p.cmpge(a.min(b).min(c)).all() && p.cmple(a.max(b).max(c)).all();
-            if inside_box && point_in_triangle_3d(p, a, b, c) {
-                return Err(PlcError::VertexOnFacet {
-                    vertex: v as usize,
-                    coords: p,
-                    facet: f as usize,
-                });
+    let mut pts: Vec<u32> = isolated.to_vec();
+    pts.sort_by(|&a, &b| vertices[a as usize].x.total_cmp(&vertices[b as usize].x));
+    let mut hit: Option<(u32, u32)> = None;
+    for &(f, _, t) in &topo.tris {
+        let [a, b, c] = t.map(|i| vertices[i as usize]);
+        let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
+        let start = pts.partition_point(|&v| vertices[v as usize].x < lo.x);
+        for &v in &pts[start..] {
+            let p = vertices[v as usize];
+            if p.x > hi.x {
+                break;
+            }
+            if p.cmpge(lo).all() && p.cmple(hi).all() && point_in_triangle_3d(p, a, b, c) {
+                // Report the lowest vertex id for a stable message.
+                hit = Some(hit.map_or((v, f), |h| if v < h.0 { (v, f) } else { h }));
             }
         }
     }
-    Ok(())
+    match hit {
+        Some((v, f)) => Err(PlcError::VertexOnFacet {
+            vertex: v as usize,
+            coords: vertices[v as usize],
+            facet: f as usize,
+        }),
+        None => Ok(()),
+    }
 }

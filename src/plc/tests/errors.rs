@@ -254,6 +254,39 @@ fn facet_hole_point_outside_or_on_edge() {
 }
 
 #[test]
+fn facet_hole_point_off_the_plane() {
+    let mut input = square();
+    input.facets[0].hole_points.push(DVec3::new(0.5, 0.5, 0.25));
+    let (e, msg) = fails(&input);
+    assert!(
+        matches!(
+            e,
+            PlcError::HolePointOffPlane {
+                facet: 0,
+                hole: 0,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    has(
+        &msg,
+        &[
+            "facet 0",
+            "hole point 0",
+            "(0.5, 0.5, 0.25)",
+            "off the facet's plane",
+        ],
+    );
+    let mut input = square();
+    input.facets[0]
+        .hole_points
+        .push(DVec3::new(0.5, f64::NAN, 0.0));
+    let (e, _) = fails(&input);
+    assert!(matches!(e, PlcError::HolePointOffPlane { .. }), "{e}");
+}
+
+#[test]
 fn polygon_inside_a_hole_borders_nothing() {
     let mut input = read_model("poly/drilled_block.poly");
     // A small square inside the drilled hole of the bottom facet (facet 0).
@@ -285,6 +318,18 @@ fn overlapping_boxes_intersect() {
         e => panic!("{e}"),
     }
     has(&msg, &["intersect other than along shared edges"]);
+}
+
+#[test]
+fn duplicate_facet_intersects() {
+    let mut input = unit_cube();
+    input.facets.push(input.facets[2].clone());
+    let (e, msg) = fails(&input);
+    assert!(
+        matches!(e, PlcError::FacetsIntersect { facets: [2, 6], .. }),
+        "{e}"
+    );
+    has(&msg, &["facets 2 and 6"]);
 }
 
 #[test]

@@ -219,6 +219,51 @@ fn boxes_touching_along_an_edge_or_a_vertex() {
 }
 
 #[test]
+fn boxes_touching_at_a_vertex() {
+    let mut input = unit_cube();
+    add_box(&mut input, DVec3::ONE, DVec3::splat(2.0));
+    // The second box's corner (1,1,1) is vertex 8: reuse the first box's vertex 7.
+    for f in &mut input.facets[6..] {
+        for v in &mut f.polygons[0] {
+            *v = match *v {
+                8 => 7,
+                x if x > 8 => x - 1,
+                x => x,
+            };
+        }
+    }
+    input.vertices.remove(8);
+    let plc = validated("vertex-touching boxes", &input);
+    assert!(close(plc.volume(), 2.0, 1e-12));
+    assert_eq!(domain_cells(&plc).len(), 2);
+}
+
+#[test]
+fn island_inside_a_cavity() {
+    // Box [0,4]^3, cavity [1,3]^3 (a hole), and a solid island [1.5,2.5]^3 inside the cavity.
+    let mut input = PlcInput::default();
+    add_box(&mut input, DVec3::ZERO, DVec3::splat(4.0));
+    add_box(&mut input, DVec3::splat(1.0), DVec3::splat(3.0));
+    add_box(&mut input, DVec3::splat(1.5), DVec3::splat(2.5));
+    input.holes.push(DVec3::splat(1.2));
+    let plc = validated("island in cavity", &input);
+    let hole = plc
+        .cells
+        .iter()
+        .find(|c| matches!(c.kind, CellKind::Hole { .. }));
+    assert!(close(hole.unwrap().volume, 7.0, 1e-12));
+    let mut cells: Vec<f64> = domain_cells(&plc).iter().map(|c| c.0).collect();
+    cells.sort_by(f64::total_cmp);
+    assert!(
+        close(cells[0], 1.0, 1e-12) && close(cells[1], 56.0, 1e-12),
+        "{cells:?}"
+    );
+    assert!(close(plc.volume(), 57.0, 1e-12));
+    // Every facet borders the domain on one side.
+    assert!(close(plc.boundary_area(), plc.total_facet_area(), 1e-12));
+}
+
+#[test]
 fn dart_prism_with_reflex_vertex() {
     // A non-convex prism: its bottom and top facets need the constrained triangulation.
     let dart = [[0.0, 0.0], [4.0, 0.0], [1.0, 1.0], [0.0, 4.0]];
@@ -238,10 +283,25 @@ fn dart_prism_with_reflex_vertex() {
     // area of the dart: triangles (A,B,C) + (A,C,D) = 2 + 2
     assert!(close(plc.facets[0].area, 4.0, 1e-12));
     assert!(close(plc.volume(), 4.0, 1e-12));
-    // The reflex side edges meet at 270° inside: no acute dihedral; the dart's tips are acute.
+    // The side walls meet at the dart's polygon angles: the tips at (4,0) and (0,4) are
+    // atan(1/3) = 18.43°, the reflex corner 270° and the corner at the origin 90°.
+    let tip = (1.0f64 / 3.0).atan().to_degrees();
     let acute = plc.acute_angles();
-    assert!(acute.dihedral_angles.iter().all(|d| d.degrees < 90.0));
-    assert!(acute.segment_angles.iter().any(|a| a.vertex == 1));
+    assert_eq!(
+        acute.dihedral_angles.len(),
+        2,
+        "{:?}",
+        acute.dihedral_angles
+    );
+    for d in &acute.dihedral_angles {
+        assert!((d.degrees - tip).abs() < 1e-9, "{d:?}");
+        let s = plc.segments[d.segment].vertices;
+        assert!(s == [1, 5] || s == [3, 7], "{s:?}");
+    }
+    assert!(acute
+        .segment_angles
+        .iter()
+        .any(|a| a.vertex == 1 && (a.degrees - tip).abs() < 1e-9));
 }
 
 /// Surfaces in off/: every triangle is a facet (no merging). They must validate as closed,
