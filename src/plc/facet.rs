@@ -172,8 +172,8 @@ pub fn build_facet(k: usize, facet: &Facet, vertices: &[DVec3]) -> Result<PlcFac
 
     for (h, &point) in facet.hole_points.iter().enumerate() {
         let distance = plane.distance(point).abs();
-        // NaN fails this test too, before it could reach the point location.
-        if !(distance <= fit.tolerance) || check_coordinate(point).is_err() {
+        // A non-finite point is rejected here, before it could reach the point location.
+        if check_coordinate(point).is_err() || distance > fit.tolerance {
             return Err(PlcError::HolePointOffPlane {
                 facet: k,
                 hole: h,
