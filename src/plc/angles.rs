@@ -2,13 +2,17 @@
 //! at a sharp angle encroach on each other; facets meeting at a sharp dihedral inside the
 //! domain squeeze the tets between them). Reported, not rejected.
 //!
-//! Angles are computed in floating point: an exact right angle between rounded decimal
-//! coordinates may come out a hair below 90°, so consumers that care should apply their own
-//! margin to `degrees`.
+//! Angles are computed in floating point, so a right angle between rounded or rotated
+//! coordinates may come out a hair below 90°; angles within [`RIGHT_ANGLE_SLACK`] of 90° are
+//! taken as right angles and not reported.
 
 use super::cells::CellKind;
 use super::Plc;
 use glam::DVec3;
+
+/// Degrees below 90° still counted as a right angle (floating-point noise, ~1e-13° in
+/// practice, is far below this; a genuinely acute input angle is far above it).
+pub const RIGHT_ANGLE_SLACK: f64 = 1e-7;
 
 /// Two segments sharing a vertex at less than 90°.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -61,7 +65,7 @@ pub(crate) fn acute_angles(plc: &Plc) -> AcuteAngles {
             for &b in &segs[i + 1..] {
                 let (x, y) = (dir(a), dir(b));
                 let degrees = x.cross(y).length().atan2(x.dot(y)).to_degrees();
-                if degrees < 90.0 {
+                if degrees < 90.0 - RIGHT_ANGLE_SLACK {
                     segment_angles.push(SegmentAngle {
                         vertex: v,
                         segments: [a, b],
@@ -99,7 +103,7 @@ pub(crate) fn acute_angles(plc: &Plc) -> AcuteAngles {
                 rad += std::f64::consts::TAU;
             }
             let degrees = rad.to_degrees();
-            if degrees < 90.0 {
+            if degrees < 90.0 - RIGHT_ANGLE_SLACK {
                 dihedral_angles.push(DihedralAngle {
                     segment: si,
                     facets: [a.facet, b.facet],

@@ -85,7 +85,9 @@ struct LocalEdge {
 
 type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
 
-/// Checks facet `k` and triangulates it. `triangle_cells` is left empty.
+/// Checks facet `k` of an input on its own (indices, polygon sizes, repeated vertices,
+/// coordinates, planarity, simple polygons, holes) and triangulates it. Surface-level checks
+/// (closure, facet intersections) need [`super::validate`]. `triangle_cells` is left empty.
 pub fn build_facet(k: usize, facet: &Facet, vertices: &[DVec3]) -> Result<PlcFacet, PlcError> {
     if facet.polygons.is_empty() {
         return Err(PlcError::EmptyFacet { facet: k });
@@ -127,6 +129,14 @@ pub fn build_facet(k: usize, facet: &Facet, vertices: &[DVec3]) -> Result<PlcFac
         }
     }
     let points: Vec<DVec3> = global.iter().map(|&v| vertices[v as usize]).collect();
+    // `validate` checks all vertices first; repeated here so this function is safe alone.
+    for (&v, &p) in global.iter().zip(&points) {
+        check_coordinate(p).map_err(|reason| PlcError::BadCoordinate {
+            vertex: v as usize,
+            coords: p,
+            reason,
+        })?;
+    }
     let first: Vec<DVec3> = polygons[0]
         .1
         .iter()
@@ -151,12 +161,12 @@ pub fn build_facet(k: usize, facet: &Facet, vertices: &[DVec3]) -> Result<PlcFac
     check_coincident(k, &p2, &global)?;
 
     let mut edges: Vec<LocalEdge> = Vec::new();
-    let mut seen: FxHashMap<(usize, usize), ()> = FxHashMap::default();
+    let mut seen: FxHashSet<(usize, usize)> = FxHashSet::default();
     for &(r, p) in &polygons {
         for i in 0..p.len() {
             let (a, b) = (local[&p[i]], local[&p[(i + 1) % p.len()]]);
             // The same edge in two polygons of one facet is one constraint.
-            if seen.insert((a.min(b), a.max(b)), ()).is_none() {
+            if seen.insert((a.min(b), a.max(b))) {
                 edges.push(LocalEdge { a, b, from: r });
             }
         }

@@ -18,7 +18,7 @@ mod intersect;
 mod plane;
 mod topology;
 
-pub use angles::{AcuteAngles, DihedralAngle, SegmentAngle};
+pub use angles::{AcuteAngles, DihedralAngle, SegmentAngle, RIGHT_ANGLE_SLACK};
 pub use cells::{Cell, CellKind};
 pub use error::{PlcError, PolygonKind, PolygonRef, Seed};
 pub use facet::{build_facet as check_facet, FacetLoop, PlcFacet};
