@@ -10,11 +10,7 @@ pub const INFINITE: u32 = u32::MAX;
 #[derive(Debug, Clone, PartialEq)]
 pub enum DelaunayError {
     /// Point `index` has a coordinate the exact predicates cannot handle.
-    BadCoordinate {
-        index: usize,
-        point: DVec3,
-        reason: crate::geom::CoordError,
-    },
+    BadCoordinate { index: usize, point: DVec3, reason: crate::geom::CoordError },
     /// Fewer than four affinely independent points: no tetrahedron exists.
     Degenerate { reason: String },
 }
@@ -22,16 +18,8 @@ pub enum DelaunayError {
 impl std::fmt::Display for DelaunayError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            DelaunayError::BadCoordinate {
-                index,
-                point,
-                reason,
-            } => {
-                write!(
-                    f,
-                    "point {index} ({}, {}, {}): {reason}",
-                    point.x, point.y, point.z
-                )
+            DelaunayError::BadCoordinate { index, point, reason } => {
+                write!(f, "point {index} ({}, {}, {}): {reason}", point.x, point.y, point.z)
             }
             DelaunayError::Degenerate { reason } => write!(f, "degenerate input: {reason}"),
         }

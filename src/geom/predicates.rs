@@ -155,11 +155,7 @@ mod tests {
         let d = DVec3::new(2.0, 3.0, 4.0); // on segment ab
         assert_eq!(orient3d(a, b, d, DVec3::new(3.0, -1.0, 7.0)), 0.0);
         // a point one ulp off the plane z = 0.5 must get the right sign
-        let p = [
-            DVec3::new(0.0, 0.0, 0.5),
-            DVec3::new(12.0, 0.0, 0.5),
-            DVec3::new(0.0, 24.0, 0.5),
-        ];
+        let p = [DVec3::new(0.0, 0.0, 0.5), DVec3::new(12.0, 0.0, 0.5), DVec3::new(0.0, 24.0, 0.5)];
         let above = DVec3::new(3.1, 7.3, f64::from_bits(0.5f64.to_bits() + 1));
         let below = DVec3::new(3.1, 7.3, f64::from_bits(0.5f64.to_bits() - 1));
         assert!(orient3d(p[0], p[1], p[2], above) > 0.0);
