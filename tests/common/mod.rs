@@ -18,7 +18,9 @@ pub fn models_dir() -> PathBuf {
 }
 
 pub fn read_model(rel: &str) -> PlcInput {
-    let opts = slivermesh::io::ReadOptions { merge_coplanar: rel.ends_with(".off") };
+    let opts = slivermesh::io::ReadOptions {
+        merge_coplanar: rel.ends_with(".off"),
+    };
     slivermesh::io::read_plc(&models_dir().join(rel), &opts)
         .unwrap_or_else(|e| panic!("reading {rel}: {e}"))
 }
@@ -31,7 +33,10 @@ pub fn tet_volume(m: &TetMesh, t: [u32; 4]) -> f64 {
 /// Every tet positively oriented.
 pub fn check_orientation(m: &TetMesh) {
     for (i, &t) in m.tets.iter().enumerate() {
-        assert!(tet_volume(m, t) > 0.0, "tet {i} {t:?} is not positively oriented");
+        assert!(
+            tet_volume(m, t) > 0.0,
+            "tet {i} {t:?} is not positively oriented"
+        );
     }
 }
 
@@ -47,13 +52,20 @@ pub fn check_delaunay(m: &TetMesh) {
         }
     }
     for (f, owners) in &faces {
-        assert!(owners.len() <= 2, "face {f:?} shared by {} tets", owners.len());
+        assert!(
+            owners.len() <= 2,
+            "face {f:?} shared by {} tets",
+            owners.len()
+        );
         if owners.len() == 2 {
             let (t, _) = owners[0];
             let (_, apex) = owners[1];
             let p = m.tets[t].map(|v| m.vertices[v as usize]);
             let s = insphere(p[0], p[1], p[2], p[3], m.vertices[apex as usize]);
-            assert!(s <= 0.0, "face {f:?}: vertex {apex} inside the circumsphere of tet {t}");
+            assert!(
+                s <= 0.0,
+                "face {f:?}: vertex {apex} inside the circumsphere of tet {t}"
+            );
         }
     }
 }
@@ -72,17 +84,23 @@ pub fn polygon_area(pts: &[DVec3]) -> f64 {
     0.5 * s.length()
 }
 
-/// Area of each input facet (outer polygons minus explicit hole polygons), summed per marker.
+/// Area of each input facet bounding the domain (as the validator measures it: holes
+/// removed), summed per marker.
 pub fn facet_area_by_marker(input: &PlcInput) -> HashMap<i32, f64> {
+    let plc = slivermesh::plc::validate(input).expect("valid input");
     let mut out: HashMap<i32, f64> = HashMap::new();
-    for f in &input.facets {
-        let area = |loops: &Vec<Vec<u32>>| -> f64 {
-            loops
-                .iter()
-                .map(|l| polygon_area(&l.iter().map(|&v| input.vertices[v as usize]).collect::<Vec<_>>()))
-                .sum()
-        };
-        *out.entry(f.marker).or_default() += area(&f.polygons) - area(&f.hole_polygons);
+    for f in &plc.facets {
+        // A facet with no domain on either side (e.g. between a hole and the outside) is not
+        // part of the meshed boundary.
+        let bounds_domain = f.triangle_cells.iter().flatten().any(|&c| {
+            matches!(
+                plc.cells[c as usize].kind,
+                slivermesh::plc::CellKind::Domain { .. }
+            )
+        });
+        if bounds_domain {
+            *out.entry(f.marker).or_default() += f.area;
+        }
     }
     out
 }
@@ -122,7 +140,10 @@ pub fn check_boundary_faces_are_tet_faces(m: &TetMesh) {
     for b in &m.boundary {
         let mut f = *b;
         f.sort_unstable();
-        assert!(faces.contains(&f), "boundary triangle {b:?} is not a tet face");
+        assert!(
+            faces.contains(&f),
+            "boundary triangle {b:?} is not a tet face"
+        );
     }
 }
 

@@ -1,0 +1,35 @@
+//! Meshes one model file and prints the report: `cargo run --release --example mesh_model -- FILE [--no-refine] [--size H]`
+use slivermesh::io::{read_plc, ReadOptions};
+use slivermesh::refine::{mesh, ConstantSpacing, Params, Spacing};
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let path = std::path::Path::new(&args[1]);
+    let merge = path.extension().is_some_and(|e| e == "off" || e == "stl");
+    let input = read_plc(
+        path,
+        &ReadOptions {
+            merge_coplanar: merge,
+        },
+    )
+    .expect("read");
+    let refine = !args.iter().any(|a| a == "--no-refine");
+    let size = args
+        .iter()
+        .position(|a| a == "--size")
+        .map(|i| args[i + 1].parse::<f64>().unwrap());
+    let params = Params {
+        refine,
+        ..Params::default()
+    };
+    let h = size.map(ConstantSpacing);
+    let sp = h.as_ref().map(|s| s as &dyn Spacing);
+    match mesh(&input, &params, sp, None) {
+        Ok((m, r)) => {
+            println!("{}", r.table());
+            if let Some(i) = args.iter().position(|a| a == "-o") {
+                slivermesh::io::write_mesh(std::path::Path::new(&args[i + 1]), &m, &[]).unwrap();
+            }
+        }
+        Err(e) => println!("error: {e}"),
+    }
+}
