@@ -17,10 +17,33 @@ fn main() {
         .iter()
         .position(|a| a == "--size")
         .map(|i| args[i + 1].parse::<f64>().unwrap());
-    let params = Params {
+    let arg = |k: &str| {
+        args.iter()
+            .position(|a| a == k)
+            .map(|i| args[i + 1].parse::<f64>().unwrap())
+    };
+    let mut params = Params {
         refine,
         ..Params::default()
     };
+    if let Some(s) = arg("--sigma") {
+        params.sigma0 = s;
+    }
+    if let Some(s) = arg("--theta") {
+        params.min_dihedral = s;
+    }
+    if let Some(s) = arg("--rho") {
+        params.rho0 = s;
+    }
+    if let Some(s) = arg("--delta") {
+        params.delta = s;
+    }
+    if let Some(s) = arg("--b") {
+        params.b = s;
+    }
+    if let Some(s) = arg("--tries") {
+        params.max_tries = s as usize;
+    }
     let h = size.map(ConstantSpacing);
     let sp = h.as_ref().map(|s| s as &dyn Spacing);
     match mesh(&input, &params, sp, None) {

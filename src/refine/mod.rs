@@ -25,6 +25,10 @@ pub struct Params {
     pub rho0: f64,
     /// Sliver bound sigma0 = V / L^3 (regular tet: 0.1179).
     pub sigma0: f64,
+    /// Practical sliver bound in degrees: a tet whose smallest dihedral angle is below it is
+    /// treated as a sliver too. sigma = V / L^3 uses the shortest edge, so a flat tet with one
+    /// short edge can pass any sigma0; the dihedral angle catches it. 0 disables.
+    pub min_dihedral: f64,
     /// Picking-region radius factor: points are drawn from the ball (c, delta * R).
     pub delta: f64,
     /// Small-sliver radius factor: a new sliver with circumradius <= b * R rejects the point.
@@ -46,6 +50,7 @@ impl Default for Params {
         Params {
             rho0: 2.0,
             sigma0: 0.02,
+            min_dihedral: 15.0,
             delta: 0.3,
             b: 4.0,
             size_factor: 1.0,
@@ -77,6 +82,12 @@ impl Params {
             return Err(format!(
                 "parameter sigma0 = {} must be finite and >= 0",
                 self.sigma0
+            ));
+        }
+        if !(self.min_dihedral.is_finite() && (0.0..70.5).contains(&self.min_dihedral)) {
+            return Err(format!(
+                "parameter min_dihedral = {} must be in [0, 70.5) degrees",
+                self.min_dihedral
             ));
         }
         if self.delta >= 1.0 {

@@ -131,8 +131,8 @@ impl<'a> Refiner<'a> {
             bad(SIZE, xi)
         } else if q.rho > p.rho0 {
             bad(RATIO, q.rho)
-        } else if q.sigma < p.sigma0 {
-            bad(SLIVER, 1.0 / q.sigma.max(1e-300))
+        } else if q.sigma < p.sigma0 || q.min_dihedral < p.min_dihedral {
+            bad(SLIVER, 1.0 / q.min_dihedral.max(1e-300))
         } else {
             None
         })
@@ -173,7 +173,40 @@ impl<'a> Refiner<'a> {
             if steps % 1024 == 0 && !progress(self.dom.dt.num_vertices()) {
                 return Err(MeshError::Cancelled);
             }
+            if std::env::var("SM_DEBUG").is_ok() && bad.class == SLIVER {
+                eprintln!("sliver pop tet {} badness {}", bad.tet, bad.badness);
+            }
+            let gave_up = self.gave_up;
             self.refine_tet(bad)?;
+            // A boundary split need not destroy the tet that asked for it: look again.
+            if self.gave_up == gave_up
+                && self.dom.dt.is_alive(bad.tet)
+                && self.dom.dt.tet(bad.tet) == bad.verts
+            {
+                self.push_tets(&[bad.tet])?;
+            }
+        }
+        if std::env::var("SM_DEBUG").is_ok() {
+            let mut counts = [0; 3];
+            let ids: Vec<u32> = self.dom.dt.finite_tet_ids().collect();
+            for t in ids {
+                if let Some(b) = self.classify(t)? {
+                    counts[b.class as usize] += 1;
+                    let q = {
+                        let [a, b2, c, d] = self.dom.dt.tet_points(t);
+                        TetQuality::of(a, b2, c, d)
+                    };
+                    eprintln!(
+                        "left: tet {t} {:?} class {} rho {} sigma {} tag {}",
+                        b.verts,
+                        b.class,
+                        q.rho,
+                        q.sigma,
+                        self.dom.dt.tag(t)
+                    );
+                }
+            }
+            eprintln!("steps {steps} remaining bad by class {counts:?}");
         }
         Ok(())
     }
@@ -263,9 +296,10 @@ impl<'a> Refiner<'a> {
             }
             let [x, y, z] = f.map(|v| self.dom.point(v));
             let q = TetQuality::of(x, y, z, p);
-            if q.circumradius <= self.params.b * r && q.sigma < self.params.sigma0 {
+            let sliver = q.sigma < self.params.sigma0 || q.min_dihedral < self.params.min_dihedral;
+            if q.circumradius <= self.params.b * r && sliver {
                 n += 1;
-                worst = worst.min(q.sigma);
+                worst = worst.min(q.min_dihedral);
             }
         }
         Some((n, worst))
