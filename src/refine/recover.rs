@@ -83,11 +83,6 @@ impl Domain {
         }
     }
 
-    /// Whether subsegment ab is an unencroached edge of the triangulation.
-    pub fn segment_ok(&self, a: u32, b: u32) -> bool {
-        self.subsegment_status(a, b) == Status::Ok
-    }
-
     /// A subsegment is fine when it is an edge of the triangulation and no vertex of a tet
     /// around it lies strictly inside its diametric ball (for a Delaunay edge, a vertex in the
     /// ball implies one among the edge's link).
@@ -208,12 +203,15 @@ impl Domain {
         Ok(())
     }
 
-    /// Subsegments of facet `f` whose closed diametric ball contains `p`.
+    /// Subsegments of facet `f` whose closed diametric ball contains `p` (up to rounding).
     pub fn facet_subsegments_encroached_by(&self, f: u32, p: DVec3) -> Vec<(u32, u32)> {
         let mut out = vec![];
         for [x, y] in self.facets[f as usize].constrained_edges() {
             let (c, r) = diametric_ball(self.point(x), self.point(y));
-            if p.distance_squared(c) <= r * r {
+            // Slightly inflated: a rounded circumcentre meant to lie on the subsegment (the
+            // hypotenuse of a right subfacet) must count as encroaching it, or it would be
+            // inserted into the facet a rounding error away from the segment.
+            if p.distance_squared(c) <= r * r * (1.0 + 1e-9) {
                 out.push(seg_key(x, y));
             }
         }
