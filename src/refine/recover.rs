@@ -37,9 +37,14 @@ impl Domain {
 
     /// Queues the subsegments and subfacets among the edges and faces of the tets the last
     /// insertion created: the new vertex may encroach them.
+    /// Also queues those among the deleted tets' edges and faces: an insertion on one facet
+    /// may remove a subfacet of another, which must then be recovered.
     pub fn queue_around_last_insertion(&mut self) {
-        for &t in self.dt.last_created() {
-            let v = self.dt.tet(t);
+        let created = self.dt.last_created().iter().map(|&t| self.dt.tet(t));
+        let quads: Vec<[u32; 4]> = created
+            .chain(self.dt.last_removed().iter().copied())
+            .collect();
+        for v in quads {
             for i in 0..4 {
                 for j in i + 1..4 {
                     let k = seg_key(v[i], v[j]);
