@@ -9,6 +9,8 @@ use crate::mesh::TetMesh;
 use crate::plc::PlcInput;
 use glam::DVec3;
 
+pub mod facet_mesh;
+
 /// Refinement parameters (names follow the paper).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Params {
