@@ -51,7 +51,6 @@ use crate::geom::{check_coordinate, insphere, orient3d};
 use glam::{DVec2, DVec3};
 use rustc_hash::FxHashMap;
 use std::collections::VecDeque;
-use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
 /// "No neighbour" (super-triangle hull edge) / global id of the temporary vertices.
 const NONE: u32 = u32::MAX;
@@ -127,7 +126,8 @@ pub enum InsertError {
     Outside,
     /// The point projects exactly onto this existing vertex.
     OnVertex(u32),
-    /// The point lies exactly on this subsegment: use [`FacetMesh::split_edge`].
+    /// The point lies exactly on this subsegment (smaller id first): use
+    /// [`FacetMesh::split_edge`].
     OnConstrainedEdge(u32, u32),
     /// The id is already a vertex of this facet (or is `u32::MAX`, reserved).
     IdInUse(u32),
@@ -174,6 +174,7 @@ impl std::fmt::Display for SplitError {
 impl std::error::Error for SplitError {}
 
 /// A facet's constrained Delaunay triangulation; see the module documentation.
+#[derive(Clone, Debug)]
 pub struct FacetMesh {
     tris: Vec<Tri>,
     /// Local vertex -> global id (NONE for the 3 super-triangle vertices, locals 0..3).
@@ -191,37 +192,8 @@ pub struct FacetMesh {
     eye: DVec3,
     n_inside: usize,
     expected_area: Option<f64>,
-    /// Walk start (last triangle found); atomic so that `locate(&self)` can update it.
-    hint: AtomicU32,
-}
-
-impl Clone for FacetMesh {
-    fn clone(&self) -> Self {
-        FacetMesh {
-            tris: self.tris.clone(),
-            gid: self.gid.clone(),
-            p3: self.p3.clone(),
-            p2: self.p2.clone(),
-            vtri: self.vtri.clone(),
-            local: self.local.clone(),
-            axes: self.axes,
-            normal: self.normal,
-            eye: self.eye,
-            n_inside: self.n_inside,
-            expected_area: self.expected_area,
-            hint: AtomicU32::new(self.hint.load(Relaxed)),
-        }
-    }
-}
-
-impl std::fmt::Debug for FacetMesh {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("FacetMesh")
-            .field("vertices", &self.num_vertices())
-            .field("triangles", &self.n_inside)
-            .field("normal", &self.normal)
-            .finish()
-    }
+    /// Walk start: a triangle at the last inserted vertex.
+    hint: u32,
 }
 
 /// Vector area (twice the area, along the right-hand normal) of a closed polygon.
@@ -362,7 +334,7 @@ impl FacetMesh {
             eye,
             n_inside: 0,
             expected_area: None,
-            hint: AtomicU32::new(0),
+            hint: 0,
         };
         // Super-triangle, well around the projected bounding box, its vertices put (in float)
         // on the plane through v0 so that the lifting treats them like the others.
@@ -419,7 +391,7 @@ impl FacetMesh {
                     return Err(format!("internal: vertex {id} outside super-triangle"))
                 }
             };
-            fm.hint.store(fm.vtri[l as usize], Relaxed);
+            fm.hint = fm.vtri[l as usize];
         }
 
         let loc = |fm: &FacetMesh, id: u32| fm.local[&id];
@@ -487,7 +459,7 @@ impl FacetMesh {
         }
         fm.make_cdt()?;
         let t = (0..fm.tris.len()).find(|&t| fm.tris[t].inside()).unwrap();
-        fm.hint.store(t as u32, Relaxed);
+        fm.hint = t as u32;
         if hole_points.is_empty() {
             let area = |p: &Vec<u32>| {
                 if p.len() >= 3 {
@@ -527,10 +499,8 @@ impl FacetMesh {
                 let tr = self.tris[t as usize];
                 if tr.cons(i) {
                     let (a, b) = (tr.v[nx(i)], tr.v[pv(i)]);
-                    return Err(InsertError::OnConstrainedEdge(
-                        self.gid[a as usize],
-                        self.gid[b as usize],
-                    ));
+                    let (a, b) = (self.gid[a as usize], self.gid[b as usize]);
+                    return Err(InsertError::OnConstrainedEdge(a.min(b), a.max(b)));
                 }
                 if !tr.inside() {
                     return Err(InsertError::Outside);
@@ -1032,7 +1002,7 @@ impl FacetMesh {
     /// Lawson flips after an insertion, then the Change (added = facet triangles around `l`).
     fn finish(&mut self, l: u32, new: Vec<u32>, mut removed: Vec<[u32; 3]>) -> Change {
         self.legalize(l, new, &mut removed);
-        self.hint.store(self.vtri[l as usize], Relaxed);
+        self.hint = self.vtri[l as usize];
         let mut added = Vec::new();
         self.find_in_star(l, |t, _| {
             if self.tris[t as usize].inside() {
@@ -1101,7 +1071,7 @@ impl FacetMesh {
 
     /// Stochastic visibility walk from the hint to projected point q.
     fn walk(&self, q: DVec2) -> Loc {
-        let mut t = self.hint.load(Relaxed);
+        let mut t = self.hint;
         if t as usize >= self.tris.len() {
             t = 0;
         }
@@ -1138,10 +1108,7 @@ impl FacetMesh {
                     }
                     (t, came) = (tr.n[i] / 3, (tr.n[i] % 3) as usize);
                 }
-                None => {
-                    self.hint.store(t, Relaxed);
-                    return Self::classify(t, zero);
-                }
+                None => return Self::classify(t, zero),
             }
         }
         // Unreachable in practice (the stochastic walk terminates); scan as a fallback.
@@ -1312,5 +1279,431 @@ impl FacetMesh {
 
 #[cfg(test)]
 mod tests {
-    // TESTS
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+    use std::collections::HashSet;
+
+    fn xy(x: f64, y: f64) -> DVec3 {
+        DVec3::new(x, y, 0.0)
+    }
+
+    /// Keeps a set of subfacets in sync through the Change lists and checks it.
+    struct Tracker(HashSet<[u32; 3]>);
+    impl Tracker {
+        fn new(m: &FacetMesh) -> Self {
+            Tracker(m.triangles().into_iter().collect())
+        }
+        fn apply(&mut self, ch: &Change, m: &FacetMesh) {
+            for r in &ch.removed {
+                assert!(self.0.remove(r), "removed {r:?} was not a triangle");
+            }
+            for a in &ch.added {
+                assert!(self.0.insert(*a), "added {a:?} twice");
+            }
+            assert_eq!(self.0, m.triangles().into_iter().collect::<HashSet<_>>());
+            assert_eq!(self.0.len(), m.num_triangles());
+        }
+    }
+
+    fn check_ccw(m: &FacetMesh) {
+        for t in m.triangles() {
+            let [a, b, c] = t.map(|i| m.point(i).unwrap());
+            assert!((b - a).cross(c - a).dot(m.normal()) > 0.0, "{t:?} not ccw");
+        }
+    }
+
+    /// Inserts `n` random points of the unit box mapped by `f`; returns how many went in.
+    fn insert_random(
+        m: &mut FacetMesh,
+        n: usize,
+        seed: u64,
+        f: impl Fn(f64, f64) -> DVec3,
+    ) -> usize {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let mut tr = Tracker::new(m);
+        let mut id = 1_000_000 + m.num_vertices() as u32;
+        let mut inserted = 0;
+        for _ in 0..n {
+            let p = f(rng.gen(), rng.gen());
+            let before = m.triangles();
+            match m.insert(id, p) {
+                Ok(ch) => {
+                    tr.apply(&ch, m);
+                    inserted += 1;
+                    id += 1;
+                }
+                Err(InsertError::Outside) => assert_eq!(before, m.triangles()),
+                Err(e) => panic!("{e}"),
+            }
+        }
+        inserted
+    }
+
+    #[test]
+    fn unit_square_both_windings() {
+        let pts = [xy(0., 0.), xy(1., 0.), xy(1., 1.), xy(0., 1.)];
+        let m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3]], &[], &[]).unwrap();
+        m.validate().unwrap();
+        assert_eq!((m.num_triangles(), m.constrained_edges().len()), (2, 4));
+        assert_eq!(m.normal(), DVec3::Z);
+        assert!((m.area() - 1.0).abs() < 1e-15);
+        check_ccw(&m);
+        let r = FacetMesh::new(&pts, &[vec![3, 2, 1, 0, 3]], &[], &[]).unwrap();
+        r.validate().unwrap();
+        assert_eq!(r.normal(), -DVec3::Z);
+        check_ccw(&r);
+    }
+
+    #[test]
+    fn l_shape() {
+        let pts =
+            [(0., 0.), (2., 0.), (2., 1.), (1., 1.), (1., 2.), (0., 2.)].map(|(x, y)| xy(x, y));
+        let mut m = FacetMesh::new(&pts, &[(0..6).collect()], &[], &[]).unwrap();
+        m.validate().unwrap();
+        assert_eq!(m.num_triangles(), 4);
+        assert!((m.area() - 3.0).abs() < 1e-14);
+        assert_eq!(m.locate(xy(1.5, 1.5)), None);
+        assert!(m.locate(xy(0.5, 1.5)).is_some());
+        assert!(m.locate(xy(1.0, 1.0)).is_some()); // reflex vertex
+        assert_eq!(m.insert(10, xy(1.5, 1.5)), Err(InsertError::Outside));
+        let n = insert_random(&mut m, 300, 7, |x, y| xy(2.0 * x, 2.0 * y));
+        assert!(n > 150 && n < 300, "{n}");
+        m.validate().unwrap();
+    }
+
+    fn square_with_hole() -> Vec<DVec3> {
+        let mut p: Vec<DVec3> = [(0., 0.), (4., 0.), (4., 4.), (0., 4.)]
+            .map(|(x, y)| xy(x, y))
+            .to_vec();
+        p.extend([(1., 1.), (3., 1.), (3., 3.), (1., 3.)].map(|(x, y)| xy(x, y)));
+        p
+    }
+
+    #[test]
+    fn square_with_hole_polygon_either_winding() {
+        let pts = square_with_hole();
+        for hole in [vec![4, 5, 6, 7], vec![7, 6, 5, 4]] {
+            let mut m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3]], &[hole], &[]).unwrap();
+            m.validate().unwrap();
+            assert_eq!((m.num_triangles(), m.constrained_edges().len()), (8, 8));
+            assert_eq!(m.locate(xy(2., 2.)), None);
+            assert_eq!(m.insert(20, xy(2., 2.)), Err(InsertError::Outside));
+            insert_random(&mut m, 200, 3, |x, y| xy(4. * x, 4. * y));
+            m.validate().unwrap();
+            assert!((m.area() - 12.0).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn square_with_hole_point() {
+        let pts = square_with_hole();
+        let outer = [vec![0, 1, 2, 3], vec![4, 5, 6, 7]];
+        let mut m = FacetMesh::new(&pts, &outer, &[], &[xy(2., 2.)]).unwrap();
+        m.validate().unwrap();
+        assert_eq!(m.num_triangles(), 8);
+        assert!((m.area() - 12.0).abs() < 1e-12);
+        assert_eq!(m.insert(20, xy(1.5, 2.5)), Err(InsertError::Outside));
+        // Without the hole point the inner polygon is just imprinted: its inside stays.
+        let m2 = FacetMesh::new(&pts, &outer, &[], &[]).unwrap();
+        assert_eq!(m2.num_triangles(), 10);
+        assert!(m2.locate(xy(2., 2.)).is_some());
+        // An island inside a hole stays.
+        let mut p = pts.clone();
+        p.extend([(1.5, 1.5), (2.5, 1.5), (2.5, 2.5), (1.5, 2.5)].map(|(x, y)| xy(x, y)));
+        let m3 = FacetMesh::new(
+            &p,
+            &[vec![0, 1, 2, 3], vec![8, 9, 10, 11]],
+            &[vec![4, 5, 6, 7]],
+            &[],
+        )
+        .unwrap();
+        assert!((m3.area() - 13.0).abs() < 1e-12);
+        assert!(m3.locate(xy(2., 2.)).is_some() && m3.locate(xy(1.2, 2.)).is_none());
+    }
+
+    /// Points of the plane through `o` spanned by `u`, `v` (exact for integer s, t).
+    fn plane(o: DVec3, u: DVec3, v: DVec3) -> impl Fn(f64, f64) -> DVec3 {
+        move |s, t| o + u * s + v * t
+    }
+
+    #[test]
+    fn tilted_planes() {
+        // x + 2y + 3z = 6 (dominant axis z) and 3x - y - 2z = -7 (dominant x, reversed winding).
+        let cases = [
+            (
+                DVec3::new(6., 0., 0.),
+                DVec3::new(-2., 1., 0.),
+                DVec3::new(-3., 0., 1.),
+                false,
+            ),
+            (
+                DVec3::new(1., 2., 3.),
+                DVec3::new(1., 3., 0.),
+                DVec3::new(0., -2., 1.),
+                true,
+            ),
+        ];
+        for (o, u, v, rev) in cases {
+            let f = plane(o, u, v);
+            // L-shape with a collinear vertex at (4, 0) and a square hole.
+            let st = [
+                (0., 0.),
+                (4., 0.),
+                (8., 0.),
+                (8., 4.),
+                (4., 4.),
+                (4., 8.),
+                (0., 8.),
+            ];
+            let mut pts: Vec<DVec3> = st.iter().map(|&(s, t)| f(s, t)).collect();
+            pts.extend([(1., 1.), (3., 1.), (3., 3.), (1., 3.)].map(|(s, t)| f(s, t)));
+            let mut outer: Vec<u32> = (0..7).collect();
+            if rev {
+                outer.reverse();
+            }
+            let mut m = FacetMesh::new(&pts, &[outer], &[vec![7, 8, 9, 10]], &[]).unwrap();
+            m.validate().unwrap();
+            let n = u.cross(v);
+            assert!(m.normal().dot(n) * if rev { -1.0 } else { 1.0 } > 0.0);
+            assert!(m.is_constrained(0, 1) && m.is_constrained(1, 2) && !m.is_constrained(0, 2));
+            // exact plane points, then float ones (a rounding error off the plane)
+            let mut tr = Tracker::new(&m);
+            for (k, (s, t)) in [(5., 1.), (6., 2.), (1., 6.), (2., 5.), (6., 3.)]
+                .iter()
+                .enumerate()
+            {
+                tr.apply(&m.insert(100 + k as u32, f(*s, *t)).unwrap(), &m);
+            }
+            insert_random(&mut m, 400, 11, |s, t| f(8.0 * s, 8.0 * t));
+            m.validate().unwrap();
+            check_ccw(&m);
+            assert!((m.area() - 44.0 * n.length()).abs() < 1e-9 * m.area());
+        }
+    }
+
+    #[test]
+    fn random_insertions_into_square() {
+        let pts = [xy(0., 0.), xy(1., 0.), xy(1., 1.), xy(0., 1.)];
+        let mut m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3]], &[], &[]).unwrap();
+        assert_eq!(insert_random(&mut m, 500, 1, xy), 500);
+        m.validate().unwrap();
+        assert_eq!(m.num_triangles(), 2 * 504 - 4 - 2);
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        for _ in 0..200 {
+            let p = xy(rng.gen(), rng.gen());
+            let [a, b, c] = m.locate(p).unwrap().map(|i| m.proj(m.point(i).unwrap()));
+            let q = m.proj(p);
+            assert!(
+                orient2d(a, b, q) >= 0.0 && orient2d(b, c, q) >= 0.0 && orient2d(c, a, q) >= 0.0
+            );
+        }
+    }
+
+    #[test]
+    fn grid_20x20_cocircular() {
+        let pts = [xy(0., 0.), xy(19., 0.), xy(19., 19.), xy(0., 19.)];
+        let mut m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3]], &[], &[]).unwrap();
+        let mut tr = Tracker::new(&m);
+        let mut grid: Vec<(u32, DVec3)> = (0..400)
+            .map(|k| (10 + k, xy((k % 20) as f64, (k / 20) as f64)))
+            .collect();
+        let mut rng = ChaCha8Rng::seed_from_u64(2);
+        for i in (1..grid.len()).rev() {
+            grid.swap(i, rng.gen_range(0..=i));
+        }
+        for (id, p) in grid {
+            let ch = match m.insert(id, p) {
+                Ok(ch) => ch,
+                Err(InsertError::OnConstrainedEdge(a, b)) => m.split_edge(a, b, id, p).unwrap(),
+                Err(InsertError::OnVertex(_)) => continue, // a corner
+                Err(e) => panic!("{e}"),
+            };
+            tr.apply(&ch, &m);
+        }
+        m.validate().unwrap();
+        assert_eq!((m.num_vertices(), m.num_triangles()), (400, 2 * 19 * 19));
+        assert_eq!(m.constrained_edges().len(), 4 * 19);
+        assert!((m.area() - 361.0).abs() < 1e-10);
+    }
+
+    #[test]
+    fn split_boundary_repeatedly_off_the_line() {
+        let f = plane(
+            DVec3::new(0.1, 0.2, 0.3),
+            DVec3::new(0.7, 0.1, -0.3),
+            DVec3::new(-0.2, 0.9, 0.4),
+        );
+        let pts: Vec<DVec3> = [(0., 0.), (3., 0.), (3., 2.), (1., 3.), (0., 2.)]
+            .map(|(s, t)| f(s, t))
+            .to_vec();
+        let mut m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3, 4]], &[], &[]).unwrap();
+        m.validate().unwrap();
+        let area0 = m.area();
+        let mut tr = Tracker::new(&m);
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        let (mut id, mut off_line) = (100u32, 0);
+        for round in 0..400 {
+            let segs = m.constrained_edges();
+            let [a, b] = segs[rng.gen_range(0..segs.len())];
+            let (pa, pb) = (m.point(a).unwrap(), m.point(b).unwrap());
+            let p = pa + (pb - pa) * rng.gen_range(0.3..0.7);
+            if orient2d(m.proj(pa), m.proj(pb), m.proj(p)) != 0.0 {
+                off_line += 1;
+            }
+            let ch = m.split_edge(a, b, id, p).unwrap();
+            tr.apply(&ch, &m);
+            assert!(m.is_constrained(a, id) && m.is_constrained(id, b) && !m.is_constrained(a, b));
+            assert_eq!(m.constrained_edges().len(), segs.len() + 1);
+            id += 1;
+            if round % 4 == 0 {
+                insert_random(&mut m, 1, round, |s, t| f(3. * s, 3. * t));
+                tr = Tracker::new(&m);
+            }
+            if round % 100 == 0 {
+                m.validate().unwrap();
+            }
+        }
+        m.validate().unwrap();
+        assert!(off_line > 100, "{off_line}");
+        assert!((m.area() - area0).abs() < 1e-9 * area0);
+        assert_eq!(
+            m.split_edge(0, 2, id, pts[1]),
+            Err(SplitError::NotAnEdge(0, 2))
+        );
+    }
+
+    #[test]
+    fn refusals_change_nothing() {
+        let pts = square_with_hole();
+        let mut m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3]], &[vec![4, 5, 6, 7]], &[]).unwrap();
+        let before = m.triangles();
+        assert_eq!(m.insert(50, xy(5., 1.)), Err(InsertError::Outside));
+        assert_eq!(m.insert(50, xy(500., -1e6)), Err(InsertError::Outside));
+        assert_eq!(m.insert(50, xy(2., 2.)), Err(InsertError::Outside));
+        assert_eq!(
+            m.insert(50, xy(2., 0.)),
+            Err(InsertError::OnConstrainedEdge(0, 1))
+        );
+        assert_eq!(
+            m.insert(50, xy(2., 1.)),
+            Err(InsertError::OnConstrainedEdge(4, 5))
+        );
+        assert_eq!(m.insert(50, xy(4., 4.)), Err(InsertError::OnVertex(2)));
+        assert_eq!(m.insert(3, xy(0.5, 0.5)), Err(InsertError::IdInUse(3)));
+        assert_eq!(m.insert(50, xy(f64::NAN, 0.5)), Err(InsertError::NotFinite));
+        assert_eq!(
+            m.split_edge(0, 2, 50, xy(2., 2.)),
+            Err(SplitError::NotAnEdge(0, 2))
+        );
+        assert_eq!(
+            m.split_edge(0, 1, 50, xy(2., 3.5)),
+            Err(SplitError::WouldInvert)
+        );
+        assert_eq!(
+            m.split_edge(0, 1, 1, xy(2., 0.)),
+            Err(SplitError::IdInUse(1))
+        );
+        assert_eq!((m.triangles(), m.num_vertices()), (before, 8));
+        m.validate().unwrap();
+        assert_eq!(m.locate(xy(2., 2.)), None);
+        assert_eq!(m.locate(xy(9., 9.)), None);
+        assert!(m.locate(xy(2., 0.)).is_some() && m.locate(xy(2., 1.)).is_some());
+    }
+
+    #[test]
+    fn flip_and_opposite() {
+        let pts = [xy(0., 0.), xy(1., 0.), xy(1., 1.), xy(0., 1.)];
+        let mut m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3]], &[], &[]).unwrap();
+        let (a, b) = if m.opposite(0, 2).is_some() {
+            (0, 2)
+        } else {
+            (1, 3)
+        };
+        let [l, r] = m.opposite(a, b).unwrap();
+        assert!(l.is_some() && r.is_some() && l != r);
+        assert_eq!(
+            m.opposite(0, 1).unwrap(),
+            [Some(if a == 0 { 2 } else { 3 }), None]
+        );
+        assert_eq!(m.opposite(1, 0).unwrap()[0], None);
+        let sorted = |m: &FacetMesh| {
+            let mut t = m.triangles();
+            t.sort();
+            t
+        };
+        let before = sorted(&m);
+        let ch = m.flip_change(a, b).unwrap();
+        assert_eq!(ch.removed.len(), 2);
+        m.validate().unwrap(); // cocircular: both diagonals are Delaunay
+        assert!(m.opposite(a, b).is_none());
+        let (c, d) = (l.unwrap(), r.unwrap());
+        assert!(m.flip(c, d));
+        assert_eq!(sorted(&m), before);
+        assert!(!m.flip(0, 1) && !m.flip(0, 9));
+        // a non-convex quad does not flip
+        let pts = [xy(0., 0.), xy(4., 0.), xy(1., 1.), xy(0., 4.)];
+        let mut m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3]], &[], &[]).unwrap();
+        assert!(m.opposite(0, 2).is_some() && !m.flip(0, 2));
+    }
+
+    #[test]
+    fn points_and_segments_inside_polygons() {
+        let mut pts = vec![xy(0., 0.), xy(1., 0.), xy(1., 1.), xy(0., 1.), xy(0.5, 0.)];
+        // a lone point on a boundary edge splits it
+        let m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3], vec![4]], &[], &[]).unwrap();
+        m.validate().unwrap();
+        assert!(m.is_constrained(0, 4) && m.is_constrained(4, 1) && !m.is_constrained(0, 1));
+        // a dangling segment is an inner subsegment
+        pts.extend([xy(0.25, 0.5), xy(0.75, 0.5), xy(0.5, 0.25), xy(0.5, 0.75)]);
+        let mut m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3], vec![5, 6]], &[], &[]).unwrap();
+        m.validate().unwrap();
+        assert!(m.is_constrained(5, 6) && m.opposite(5, 6).unwrap().iter().all(|x| x.is_some()));
+        assert_eq!(
+            m.insert(20, xy(0.5, 0.5)),
+            Err(InsertError::OnConstrainedEdge(5, 6))
+        );
+        m.split_edge(5, 6, 20, xy(0.5, 0.5)).unwrap();
+        m.validate().unwrap();
+        // crossing segments, coincident vertices, no area
+        let e = FacetMesh::new(&pts, &[vec![0, 1, 2, 3], vec![5, 6], vec![7, 8]], &[], &[])
+            .unwrap_err();
+        assert!(e.contains("cross"), "{e}");
+        pts.push(xy(0.25, 0.5));
+        let e = FacetMesh::new(&pts, &[vec![0, 1, 2, 3], vec![5, 9]], &[], &[]).unwrap_err();
+        assert!(e.contains("coincide"), "{e}");
+        assert!(FacetMesh::new(&pts, &[vec![0, 1, 4]], &[], &[]).is_err());
+        assert!(FacetMesh::new(&pts, &[vec![0, 1, 99]], &[], &[]).is_err());
+    }
+
+    #[test]
+    fn rotated_float_facet() {
+        // Coordinates rounded after a rotation: not exactly coplanar.
+        let q = glam::DQuat::from_axis_angle(DVec3::new(0.3, -0.5, 0.8).normalize(), 0.7);
+        let f = move |s: f64, t: f64| q * DVec3::new(s, t, 0.0) + DVec3::new(0.1, 2.3, -0.7);
+        let pts = square_with_hole()
+            .iter()
+            .map(|p| f(p.x, p.y))
+            .collect::<Vec<_>>();
+        let mut m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3]], &[vec![4, 5, 6, 7]], &[]).unwrap();
+        m.validate().unwrap();
+        insert_random(&mut m, 1000, 4, |s, t| f(4. * s, 4. * t));
+        m.validate().unwrap();
+        check_ccw(&m);
+        assert!((m.area() - 12.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn many_insertions_stay_fast() {
+        let pts = [xy(0., 0.), xy(1., 0.), xy(1., 1.), xy(0., 1.)];
+        let mut m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3]], &[], &[]).unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(8);
+        let t0 = std::time::Instant::now();
+        for id in 10..20_010 {
+            m.insert(id, xy(rng.gen(), rng.gen())).unwrap();
+        }
+        let dt = t0.elapsed();
+        m.validate().unwrap();
+        assert!(dt.as_secs_f64() < 10.0, "{dt:?}");
+    }
 }
