@@ -833,10 +833,17 @@ impl FacetMesh {
         canon(self.tris[t as usize].v.map(|v| self.gid[v as usize]))
     }
 
-    /// Exact "d strictly inside the circle of ccw (a, b, c)" through the lifting from `eye`.
+    /// Exact "d strictly inside the circle of ccw (a, b, c)" through the lifting from `eye`,
+    /// for d across edge (b, c). Symmetric: equals "a inside the circle of (d, c, b)". It reads
+    /// the sign from a triangle whose lifted tet is positive; a nearly flat triangle of points
+    /// off the plane may have a non-positive one, and if both do the edge is left as it is.
     fn incircle(&self, a: u32, b: u32, c: u32, d: u32) -> bool {
         let [a, b, c, d] = [a, b, c, d].map(|v| self.p3[v as usize]);
-        orient3d(a, b, c, self.eye) > 0.0 && insphere(a, b, c, self.eye, d) > 0.0
+        if orient3d(a, b, c, self.eye) > 0.0 {
+            insphere(a, b, c, self.eye, d) > 0.0
+        } else {
+            orient3d(d, c, b, self.eye) > 0.0 && insphere(d, c, b, self.eye, a) > 0.0
+        }
     }
 
     /// Whether replacing diagonal (x, y) of the quad (c, x, d, y) by (c, d) gives two ccw
