@@ -561,16 +561,7 @@ impl FacetMesh {
 
     /// The facet triangles around vertex `id` (empty if it is not a vertex).
     pub fn triangles_around(&self, id: u32) -> Vec<[u32; 3]> {
-        let mut out = Vec::new();
-        if let Some(&l) = self.local.get(&id) {
-            self.find_in_star(l, |t, _| {
-                if self.tris[t as usize].inside() {
-                    out.push(self.gtri(t));
-                }
-                false
-            });
-        }
-        out
+        self.local.get(&id).map_or(Vec::new(), |&l| self.star(l))
     }
 
     /// All constrained edges (subsegments), each once as [min id, max id].
@@ -661,18 +652,12 @@ impl FacetMesh {
         }
         let mut n_in = 0;
         for (t, tr) in self.tris.iter().enumerate() {
-            let g = |k: usize| self.gid[tr.v[k] as usize];
             if tr.v.iter().any(|&v| v as usize >= nv) || tr.v[0] == tr.v[1] || tr.v[1] == tr.v[2] {
                 return Err(format!("triangle {t} has bad vertices {:?}", tr.v));
             }
             let [a, b, c] = tr.v.map(|v| self.p2[v as usize]);
             if orient2d(a, b, c) <= 0.0 {
-                return Err(format!(
-                    "triangle {t} ({}, {}, {}) is not ccw",
-                    g(0),
-                    g(1),
-                    g(2)
-                ));
+                return Err(format!("triangle {:?} is not ccw", self.gtri(t as u32)));
             }
             if tr.inside() {
                 n_in += 1;
@@ -690,10 +675,7 @@ impl FacetMesh {
                     continue;
                 }
                 let (u, j) = ((r / 3) as usize, (r % 3) as usize);
-                let ur = self
-                    .tris
-                    .get(u)
-                    .ok_or(format!("triangle {t}: bad neighbour"))?;
+                let ur = self.tris.get(u).ok_or("bad neighbour reference")?;
                 if ur.n[j] != (t * 3 + i) as u32 || ur.v[nx(j)] != y || ur.v[pv(j)] != x {
                     return Err(format!("triangles {t} and {u} disagree on their edge"));
                 }
@@ -701,31 +683,21 @@ impl FacetMesh {
                     return Err(format!("triangles {t}, {u}: constrained flag differs"));
                 }
                 if !tr.cons(i) && tr.inside() != ur.inside() {
-                    return Err(format!(
-                        "facet boundary between {t} and {u} not constrained"
-                    ));
+                    return Err(format!("facet boundary {t}|{u} not constrained"));
                 }
                 if tr.cons(i) && !tr.inside() && !ur.inside() {
                     return Err(format!("constrained edge of {t} outside the facet"));
                 }
                 if tr.inside() && !tr.cons(i) && self.incircle(tr.v[i], x, y, ur.v[j]) {
+                    let (d, [a, b, c]) = (self.gid[ur.v[j] as usize], self.gtri(t as u32));
                     return Err(format!(
-                        "edge ({}, {}) not locally Delaunay: {} inside circle of ({}, {}, {})",
-                        g(nx(i)),
-                        g(pv(i)),
-                        self.gid[ur.v[j] as usize],
-                        g(0),
-                        g(1),
-                        g(2)
+                        "not locally Delaunay: {d} in circle of {a}, {b}, {c}"
                     ));
                 }
             }
         }
         if n_in != self.n_inside {
-            return Err(format!(
-                "{n_in} facet triangles, counter says {}",
-                self.n_inside
-            ));
+            return Err(format!("{n_in} facet triangles, not {}", self.n_inside));
         }
         for v in 0..nv {
             let t = self.vtri[v] as usize;
@@ -772,6 +744,11 @@ impl FacetMesh {
             Loc::Edge(t, i) => (l, self.split_edge_at(t, i, l)),
             _ => unreachable!("place: {loc:?}"),
         }
+    }
+
+    /// The vertex across neighbour reference `r` (the apex of the other triangle).
+    fn apex(&self, r: u32) -> u32 {
+        self.tris[(r / 3) as usize].v[(r % 3) as usize]
     }
 
     /// A triangle's global ids, canonical.
@@ -923,9 +900,7 @@ impl FacetMesh {
         if tr.cons(i) || tr.n[i] == NONE {
             return false;
         }
-        let r = tr.n[i];
-        let d = self.tris[(r / 3) as usize].v[(r % 3) as usize];
-        let (c, x, y) = (tr.v[i], tr.v[nx(i)], tr.v[pv(i)]);
+        let (c, x, y, d) = (tr.v[i], tr.v[nx(i)], tr.v[pv(i)], self.apex(tr.n[i]));
         self.incircle(c, x, y, d) && self.convex(c, x, y, d)
     }
 
@@ -956,14 +931,20 @@ impl FacetMesh {
     fn finish(&mut self, l: u32, new: Vec<u32>, mut removed: Vec<[u32; 3]>) -> Change {
         self.legalize(l, new, &mut removed);
         self.hint = self.vtri[l as usize];
-        let mut added = Vec::new();
+        let added = self.star(l);
+        Change { removed, added }
+    }
+
+    /// The facet triangles (global ids) around local vertex `l`.
+    fn star(&self, l: u32) -> Vec<[u32; 3]> {
+        let mut out = Vec::new();
         self.find_in_star(l, |t, _| {
             if self.tris[t as usize].inside() {
-                added.push(self.gtri(t));
+                out.push(self.gtri(t));
             }
             false
         });
-        Change { removed, added }
+        out
     }
 
     /// Visits the triangles around local vertex `v` as (triangle, index of v) until `f` says
@@ -1024,11 +1005,7 @@ impl FacetMesh {
 
     /// Stochastic visibility walk from the hint to projected point q.
     fn walk(&self, q: DVec2) -> Loc {
-        let mut t = self.hint;
-        if t as usize >= self.tris.len() {
-            t = 0;
-        }
-        let mut came = 3;
+        let (mut t, mut came) = (self.hint, 3);
         let mut rng = (q.x.to_bits() ^ q.y.to_bits().rotate_left(29)) as u32 | 1;
         for _ in 0..4 * self.tris.len() + 64 {
             let tr = self.tris[t as usize];
@@ -1043,11 +1020,7 @@ impl FacetMesh {
                 if i == came {
                     continue;
                 }
-                let o = orient2d(
-                    self.p2[tr.v[nx(i)] as usize],
-                    self.p2[tr.v[pv(i)] as usize],
-                    q,
-                );
+                let o = self.side(&tr, i, q);
                 if o < 0.0 {
                     next = Some(i);
                     break;
@@ -1066,18 +1039,21 @@ impl FacetMesh {
         }
         // Unreachable in practice (the stochastic walk terminates); scan as a fallback.
         for (t, tr) in self.tris.iter().enumerate() {
-            let o = [0, 1, 2].map(|i| {
-                orient2d(
-                    self.p2[tr.v[nx(i)] as usize],
-                    self.p2[tr.v[pv(i)] as usize],
-                    q,
-                )
-            });
+            let o = [0, 1, 2].map(|i| self.side(tr, i, q));
             if o.iter().all(|&x| x >= 0.0) {
                 return Self::classify(t as u32, o.map(|x| x == 0.0));
             }
         }
         Loc::Outside
+    }
+
+    /// orient2d of edge `i` of `tr` (as the triangle runs) and q: > 0 on the triangle's side.
+    fn side(&self, tr: &Tri, i: usize, q: DVec2) -> f64 {
+        orient2d(
+            self.p2[tr.v[nx(i)] as usize],
+            self.p2[tr.v[pv(i)] as usize],
+            q,
+        )
     }
 
     fn classify(t: u32, zero: [bool; 3]) -> Loc {
@@ -1135,22 +1111,15 @@ impl FacetMesh {
             let tr = self.tris[t as usize];
             let (v1, v2) = (tr.v[nx(e)], tr.v[pv(e)]);
             if tr.cons(e) {
-                let g = |v: u32| self.gid[v as usize];
-                return Err(format!(
-                    "polygon edges cross: ({}, {}) and ({}, {})",
-                    g(s),
-                    g(b),
-                    g(v1),
-                    g(v2)
-                ));
+                let [s, b, v1, v2] = [s, b, v1, v2].map(|v| self.gid[v as usize]);
+                return Err(format!("polygon edges cross: ({s}, {b}) and ({v1}, {v2})"));
             }
             cross.push((v1, v2));
             let r = tr.n[e];
             if r == NONE {
                 return Err("internal: constraint left the super-triangle".into());
             }
-            let (u, j) = (r / 3, (r % 3) as usize);
-            let w = self.tris[u as usize].v[j];
+            let (u, j, w) = (r / 3, (r % 3) as usize, self.apex(r));
             if w == b {
                 return Ok((b, cross));
             }
@@ -1173,9 +1142,7 @@ impl FacetMesh {
                 .find_edge(x, y)
                 .ok_or("internal: crossing edge vanished")?;
             let tr = self.tris[t as usize];
-            let r = tr.n[i];
-            let d = self.tris[(r / 3) as usize].v[(r % 3) as usize];
-            let c = tr.v[i];
+            let (c, d) = (tr.v[i], self.apex(tr.n[i]));
             if self.convex(c, tr.v[nx(i)], tr.v[pv(i)], d) {
                 self.flip_at(t, i);
                 stall = 0;
@@ -1218,8 +1185,7 @@ impl FacetMesh {
             }
             budget -= 1;
             let tr = self.tris[t as usize];
-            let d = self.tris[(tr.n[i] / 3) as usize].v[(tr.n[i] % 3) as usize];
-            let (c, x, y) = (tr.v[i], tr.v[nx(i)], tr.v[pv(i)]);
+            let (c, x, y, d) = (tr.v[i], tr.v[nx(i)], tr.v[pv(i)], self.apex(tr.n[i]));
             self.flip_at(t, i);
             stack.extend([(c, x), (x, d), (d, y), (y, c)]);
         }
@@ -1234,25 +1200,17 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
     use std::collections::HashSet;
 
-    fn xy(c: &[(f64, f64)]) -> Vec<DVec3> {
-        c.iter().map(|&(x, y)| DVec3::new(x, y, 0.0)).collect()
+    /// Points of the plane z = 0 from flat (x, y) pairs.
+    fn xy(c: &[f64]) -> Vec<DVec3> {
+        c.chunks(2).map(|c| DVec3::new(c[0], c[1], 0.0)).collect()
     }
     fn p(x: f64, y: f64) -> DVec3 {
         DVec3::new(x, y, 0.0)
     }
-    const SQUARE: [(f64, f64); 4] = [(0., 0.), (1., 0.), (1., 1.), (0., 1.)];
-    fn square_with_hole() -> Vec<DVec3> {
-        xy(&[
-            (0., 0.),
-            (4., 0.),
-            (4., 4.),
-            (0., 4.),
-            (1., 1.),
-            (3., 1.),
-            (3., 3.),
-            (1., 3.),
-        ])
-    }
+    const SQUARE: [f64; 8] = [0., 0., 1., 0., 1., 1., 0., 1.];
+    const SQUARE_HOLE: [f64; 16] = [
+        0., 0., 4., 0., 4., 4., 0., 4., 1., 1., 3., 1., 3., 3., 1., 3.,
+    ];
     /// Points of the plane through `o` spanned by `u`, `v` (exact for small integer s, t).
     fn plane(o: DVec3, u: DVec3, v: DVec3) -> impl Fn(f64, f64) -> DVec3 {
         move |s, t| o + u * s + v * t
@@ -1348,10 +1306,8 @@ mod tests {
         };
         let [l, r] = m.opposite(a, b).unwrap();
         assert!(l.is_some() && r.is_some() && l != r);
-        assert_eq!(
-            m.opposite(0, 1).unwrap(),
-            [Some(if a == 0 { 2 } else { 3 }), None]
-        );
+        let c = if a == 0 { 2 } else { 3 };
+        assert_eq!(m.opposite(0, 1).unwrap(), [Some(c), None]);
         assert_eq!(m.opposite(1, 0).unwrap()[0], None);
         let sorted = |m: &FacetMesh| {
             let mut t = m.triangles();
@@ -1367,14 +1323,14 @@ mod tests {
         assert_eq!(sorted(&m), before);
         assert!(!m.flip(0, 1) && !m.flip(0, 9));
         // a non-convex quad does not flip
-        let pts = xy(&[(0., 0.), (4., 0.), (1., 1.), (0., 4.)]);
+        let pts = xy(&[0., 0., 4., 0., 1., 1., 0., 4.]);
         let mut m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3]], &[], &[]).unwrap();
         assert!(m.opposite(0, 2).is_some() && !m.flip(0, 2));
     }
 
     #[test]
     fn l_shape() {
-        let pts = xy(&[(0., 0.), (2., 0.), (2., 1.), (1., 1.), (1., 2.), (0., 2.)]);
+        let pts = xy(&[0., 0., 2., 0., 2., 1., 1., 1., 1., 2., 0., 2.]);
         let mut m = FacetMesh::new(&pts, &[(0..6).collect()], &[], &[]).unwrap();
         m.validate().unwrap();
         assert_eq!((m.num_triangles(), m.area()), (4, 3.0));
@@ -1387,7 +1343,7 @@ mod tests {
 
     #[test]
     fn square_with_holes() {
-        let pts = square_with_hole();
+        let pts = xy(&SQUARE_HOLE);
         for hole in [vec![4, 5, 6, 7], vec![7, 6, 5, 4]] {
             let mut m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3]], &[hole], &[]).unwrap();
             m.validate().unwrap();
@@ -1409,7 +1365,7 @@ mod tests {
         assert!(m.locate(p(2., 2.)).is_some());
         // an island inside a hole stays
         let mut pts = pts.clone();
-        pts.extend(xy(&[(1.5, 1.5), (2.5, 1.5), (2.5, 2.5), (1.5, 2.5)]));
+        pts.extend(xy(&[1.5, 1.5, 2.5, 1.5, 2.5, 2.5, 1.5, 2.5]));
         let outer = [vec![0, 1, 2, 3], vec![8, 9, 10, 11]];
         let m = FacetMesh::new(&pts, &outer, &[vec![4, 5, 6, 7]], &[]).unwrap();
         m.validate().unwrap();
@@ -1421,33 +1377,18 @@ mod tests {
     fn tilted_planes() {
         // x + 2y + 3z = 6 (dominant axis z) and 3x - y - 2z = -7 (dominant x, reversed winding)
         let cases = [
-            (
-                DVec3::new(6., 0., 0.),
-                DVec3::new(-2., 1., 0.),
-                DVec3::new(-3., 0., 1.),
-                false,
-            ),
-            (
-                DVec3::new(1., 2., 3.),
-                DVec3::new(1., 3., 0.),
-                DVec3::new(0., -2., 1.),
-                true,
-            ),
+            ([6., 0., 0.], [-2., 1., 0.], [-3., 0., 1.], false),
+            ([1., 2., 3.], [1., 3., 0.], [0., -2., 1.], true),
         ];
         for (o, u, v, rev) in cases {
-            let f = plane(o, u, v);
+            let (u, v) = (DVec3::from(u), DVec3::from(v));
+            let f = plane(o.into(), u, v);
             // an L with a collinear vertex at (4, 0), and a square hole
             let st = [
-                (0., 0.),
-                (4., 0.),
-                (8., 0.),
-                (8., 4.),
-                (4., 4.),
-                (4., 8.),
-                (0., 8.),
+                0., 0., 4., 0., 8., 0., 8., 4., 4., 4., 4., 8., 0., 8., 1., 1., 3., 1., 3., 3., 1.,
+                3.,
             ];
-            let mut pts: Vec<DVec3> = st.iter().map(|&(s, t)| f(s, t)).collect();
-            pts.extend([(1., 1.), (3., 1.), (3., 3.), (1., 3.)].map(|(s, t)| f(s, t)));
+            let pts: Vec<DVec3> = st.chunks(2).map(|c| f(c[0], c[1])).collect();
             let mut outer: Vec<u32> = (0..7).collect();
             if rev {
                 outer.reverse();
@@ -1458,11 +1399,12 @@ mod tests {
             assert!(m.normal().dot(n) * if rev { -1.0 } else { 1.0 } > 0.0);
             assert!(m.is_constrained(0, 1) && m.is_constrained(1, 2) && !m.is_constrained(0, 2));
             let mut tr = Tracker::new(&m);
-            for (k, (s, t)) in [(5., 1.), (6., 2.), (1., 6.), (2., 5.), (6., 3.)]
-                .iter()
+            for (k, c) in [5., 1., 6., 2., 1., 6., 2., 5., 6., 3.]
+                .chunks(2)
                 .enumerate()
             {
-                tr.apply(&m.insert(100 + k as u32, f(*s, *t)).unwrap(), &m); // exactly on the plane
+                tr.apply(&m.insert(100 + k as u32, f(c[0], c[1])).unwrap(), &m);
+                // on the plane
             }
             drive(&mut m, 500, 0.2, 11, |s, t| f(8.0 * s, 8.0 * t)); // a rounding error off it
             assert!((m.area() - 44.0 * n.length()).abs() < 1e-9 * m.area());
@@ -1479,9 +1421,9 @@ mod tests {
             let q = p(rng.gen(), rng.gen());
             let [a, b, c] = m.locate(q).unwrap().map(|i| m.proj(m.point(i).unwrap()));
             let q = m.proj(q);
-            assert!(
-                orient2d(a, b, q) >= 0.0 && orient2d(b, c, q) >= 0.0 && orient2d(c, a, q) >= 0.0
-            );
+            assert!([(a, b), (b, c), (c, a)]
+                .iter()
+                .all(|&(x, y)| orient2d(x, y, q) >= 0.0));
         }
         // many more: stays fast (walk + flips, not O(n) per insertion)
         let t0 = std::time::Instant::now();
@@ -1494,13 +1436,8 @@ mod tests {
 
     #[test]
     fn grid_20x20_cocircular() {
-        let mut m = FacetMesh::new(
-            &xy(&SQUARE.map(|(x, y)| (19. * x, 19. * y))),
-            &[vec![0, 1, 2, 3]],
-            &[],
-            &[],
-        )
-        .unwrap();
+        let pts = xy(&SQUARE.map(|c| 19. * c));
+        let mut m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3]], &[], &[]).unwrap();
         let mut tr = Tracker::new(&m);
         let mut grid: Vec<u32> = (10..410).collect();
         let mut rng = ChaCha8Rng::seed_from_u64(2);
@@ -1524,14 +1461,12 @@ mod tests {
 
     #[test]
     fn split_boundary_repeatedly_off_the_line() {
-        let f = plane(
-            DVec3::new(0.1, 0.2, 0.3),
-            DVec3::new(0.7, 0.1, -0.3),
-            DVec3::new(-0.2, 0.9, 0.4),
-        );
-        let pts: Vec<DVec3> = [(0., 0.), (3., 0.), (3., 2.), (1., 3.), (0., 2.)]
-            .map(|(s, t)| f(s, t))
-            .to_vec();
+        let [o, u, v] = [[0.1, 0.2, 0.3], [0.7, 0.1, -0.3], [-0.2, 0.9, 0.4]].map(DVec3::from);
+        let f = plane(o, u, v);
+        let pts: Vec<DVec3> = [0., 0., 3., 0., 3., 2., 1., 3., 0., 2.]
+            .chunks(2)
+            .map(|c| f(c[0], c[1]))
+            .collect();
         let mut m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3, 4]], &[], &[]).unwrap();
         m.validate().unwrap();
         // split points are not exactly on the segments
@@ -1548,7 +1483,7 @@ mod tests {
 
     #[test]
     fn refusals_change_nothing() {
-        let pts = square_with_hole();
+        let pts = xy(&SQUARE_HOLE);
         let mut m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3]], &[vec![4, 5, 6, 7]], &[]).unwrap();
         let before = m.triangles();
         for (q, e) in [
@@ -1563,18 +1498,13 @@ mod tests {
             assert_eq!(m.insert(50, q), Err(e));
         }
         assert_eq!(m.insert(3, p(0.5, 0.5)), Err(InsertError::IdInUse(3)));
-        assert_eq!(
-            m.split_edge(0, 2, 50, p(2., 2.)),
-            Err(SplitError::NotAnEdge(0, 2))
-        );
-        assert_eq!(
-            m.split_edge(0, 1, 50, p(2., 3.5)),
-            Err(SplitError::WouldInvert)
-        );
-        assert_eq!(
-            m.split_edge(0, 1, 1, p(2., 0.)),
-            Err(SplitError::IdInUse(1))
-        );
+        for (a, b, id, q, e) in [
+            (0, 2, 50, p(2., 2.), SplitError::NotAnEdge(0, 2)),
+            (0, 1, 50, p(2., 3.5), SplitError::WouldInvert),
+            (0, 1, 1, p(2., 0.), SplitError::IdInUse(1)),
+        ] {
+            assert_eq!(m.split_edge(a, b, id, q), Err(e));
+        }
         assert_eq!((m.triangles(), m.num_vertices()), (before, 8));
         m.validate().unwrap();
         assert_eq!((m.locate(p(2., 2.)), m.locate(p(9., 9.))), (None, None));
@@ -1583,15 +1513,11 @@ mod tests {
 
     #[test]
     fn points_and_segments_inside_polygons() {
-        let mut pts = xy(&[
-            (0., 0.),
-            (1., 0.),
-            (1., 1.),
-            (0., 1.),
-            (0.5, 0.),
-            (0.25, 0.5),
-        ]);
-        pts.extend(xy(&[(0.75, 0.5), (0.5, 0.25), (0.5, 0.75), (0.25, 0.5)]));
+        let pts = [
+            0., 0., 1., 0., 1., 1., 0., 1., 0.5, 0., 0.25, 0.5, 0.75, 0.5, 0.5, 0.25, 0.5, 0.75,
+        ];
+        let mut pts = xy(&pts);
+        pts.push(p(0.25, 0.5));
         // a lone point on a boundary edge splits it
         let m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3], vec![4]], &[], &[]).unwrap();
         m.validate().unwrap();
@@ -1600,10 +1526,8 @@ mod tests {
         let mut m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3], vec![5, 6]], &[], &[]).unwrap();
         m.validate().unwrap();
         assert!(m.is_constrained(5, 6) && m.opposite(5, 6).unwrap().iter().all(|x| x.is_some()));
-        assert_eq!(
-            m.insert(20, p(0.5, 0.5)),
-            Err(InsertError::OnConstrainedEdge(5, 6))
-        );
+        let e = m.insert(20, p(0.5, 0.5));
+        assert_eq!(e, Err(InsertError::OnConstrainedEdge(5, 6)));
         m.split_edge(5, 6, 20, p(0.5, 0.5)).unwrap();
         m.validate().unwrap();
         // errors: crossing segments, coincident vertices, no area, bad id
@@ -1625,18 +1549,11 @@ mod tests {
             let q = glam::DQuat::from_axis_angle(axis, rng.gen_range(0.0..6.0));
             let f = move |s: f64, t: f64| q * DVec3::new(s, t, 0.0) + DVec3::new(0.1, 2.3, -0.7);
             let n = rng.gen_range(3..60);
+            let round = |x: f64| if seed % 2 == 0 { x.round() } else { x };
             let mut st: Vec<(f64, f64)> = (0..n)
                 .map(|i| {
-                    let (a, r) = (
-                        i as f64 / n as f64 * std::f64::consts::TAU,
-                        rng.gen_range(3.0..5.0),
-                    );
-                    let (s, t) = (a.cos() * r, a.sin() * r);
-                    if seed % 2 == 0 {
-                        (s.round(), t.round())
-                    } else {
-                        (s, t)
-                    }
+                    let (a, r) = (i as f64 / n as f64 * 6.283, rng.gen_range(3.0..5.0));
+                    (round(a.cos() * r), round(a.sin() * r))
                 })
                 .collect();
             st.dedup();
@@ -1658,10 +1575,9 @@ mod tests {
                 let tris = m.triangles();
                 let [a, b, c] = tris[rng.gen_range(0..tris.len())].map(|i| m.point(i).unwrap());
                 let (ab, ac) = (b - a, c - a);
-                let nn = ab.cross(ac);
-                let cc = a
-                    + (nn.cross(ab) * ac.length_squared() + ac.cross(nn) * ab.length_squared())
-                        / (2.0 * nn.length_squared());
+                let (n, l2) = (ab.cross(ac), [ab.length_squared(), ac.length_squared()]);
+                let cc =
+                    a + (n.cross(ab) * l2[1] + ac.cross(n) * l2[0]) / (2.0 * n.length_squared());
                 if let Ok(ch) = m.insert(id, cc) {
                     tr.apply(&ch, &m);
                 }
