@@ -57,6 +57,15 @@ const NONE: u32 = u32::MAX;
 /// Flag bit: triangle is part of the facet.
 const INSIDE: u8 = 8;
 
+/// Returns `Err(format!(..))` unless the condition holds.
+macro_rules! ensure {
+    ($c:expr, $($m:tt)+) => {
+        if !$c {
+            return Err(format!($($m)+));
+        }
+    };
+}
+
 #[inline(always)]
 fn nx(i: usize) -> usize {
     [1, 2, 0][i]
@@ -258,9 +267,8 @@ impl FacetMesh {
         for &h in hole_points {
             check_coordinate(h).map_err(|e| format!("hole point {h}: {e}"))?;
         }
-        if let Some(h) = holes.iter().find(|h| h.len() < 3) {
-            return Err(format!("hole polygon {h:?} has fewer than 3 vertices"));
-        }
+        let short = holes.iter().find(|h| h.len() < 3);
+        ensure!(short.is_none(), "hole {short:?}: under 3 vertices");
 
         // Normal and projection from the outer polygon with the largest area; the exact winding
         // at its extreme vertex orders the 2D axes so that it is counter-clockwise.
@@ -273,19 +281,14 @@ impl FacetMesh {
         let k = (0..3)
             .max_by(|&i, &j| nrm[i].abs().total_cmp(&nrm[j].abs()))
             .unwrap();
-        if nrm[k] == 0.0 || !nrm.is_finite() {
-            return Err(format!("outer polygon {best:?} has no area"));
-        }
+        let ok = nrm[k] != 0.0 && nrm.is_finite();
+        ensure!(ok, "outer polygon {best:?} has no area");
         let cyc = [(k + 1) % 3, (k + 2) % 3];
         let (w, m) = winding(best, |id| {
             let p = points[id as usize];
             DVec2::new(p[cyc[0]], p[cyc[1]])
         });
-        if w == 0.0 {
-            return Err(format!(
-                "outer polygon {best:?} is degenerate or not simple"
-            ));
-        }
+        ensure!(w != 0.0, "polygon {best:?} degenerate/not simple");
         let (axes, s) = if w > 0.0 {
             (cyc, 1.0)
         } else {
@@ -297,9 +300,8 @@ impl FacetMesh {
         let v0 = points[best[m] as usize];
         let eye = v0 + DVec3::AXES[k] * (s * (hi - lo).max_element());
         let [a, b] = [best[(m + n - 1) % n], best[(m + 1) % n]].map(|i| points[i as usize]);
-        if orient3d(a, v0, b, eye) <= 0.0 {
-            return Err(format!("facet polygon {best:?} is too far from planar"));
-        }
+        let ok = orient3d(a, v0, b, eye) > 0.0;
+        ensure!(ok, "polygon {best:?} is too far from planar");
 
         let mut fm = FacetMesh {
             tris: Vec::with_capacity(2 * ids.len() + 8),
@@ -356,9 +358,7 @@ impl FacetMesh {
         let mut seeds = vec![fm.vtri[0]];
         for poly in &holes {
             let (w, _) = winding(poly, |id| fm.p2[loc(&fm, id) as usize]);
-            if w == 0.0 {
-                return Err(format!("hole polygon {poly:?} is degenerate or not simple"));
-            }
+            ensure!(w != 0.0, "hole {poly:?} degenerate/not simple");
             for (a, b) in poly_edges(poly) {
                 for e in fm.recover(loc(&fm, a), loc(&fm, b))?.windows(2) {
                     let (t, i) = fm.find_edge(e[0], e[1]).unwrap();
@@ -388,9 +388,7 @@ impl FacetMesh {
             tr.f |= INSIDE;
             fm.n_inside += 1;
         }
-        if fm.n_inside == 0 {
-            return Err("the facet has no area left (holes cover it)".into());
-        }
+        ensure!(fm.n_inside > 0, "holes cover the whole facet");
         for tr in &fm.tris {
             for i in (0..3).filter(|&i| tr.cons(i) && !tr.inside()) {
                 if !fm.tris[(tr.n[i] / 3) as usize].inside() {
@@ -646,73 +644,51 @@ impl FacetMesh {
     /// constrained Delaunay (no apex strictly inside across a non-constrained facet edge), and
     /// the facet's area against the polygons' area (relative 1e-9; see the module limits).
     pub fn validate(&self) -> Result<(), String> {
-        let nv = self.gid.len();
-        if self.tris.len() != 2 * nv - 5 {
-            return Err(format!("{} triangles for {nv} vertices", self.tris.len()));
-        }
+        let (nv, nt) = (self.gid.len(), self.tris.len());
+        ensure!(nt == 2 * nv - 5, "{nt} triangles for {nv} vertices");
         let mut n_in = 0;
         for (t, tr) in self.tris.iter().enumerate() {
-            if tr.v.iter().any(|&v| v as usize >= nv) || tr.v[0] == tr.v[1] || tr.v[1] == tr.v[2] {
-                return Err(format!("triangle {t} has bad vertices {:?}", tr.v));
-            }
+            let ([a, b, c], g) = (tr.v, self.gtri(t as u32));
+            let ok = a.max(b).max(c) < nv as u32 && a != b && b != c && c != a;
+            ensure!(ok, "triangle {t}: bad vertices");
             let [a, b, c] = tr.v.map(|v| self.p2[v as usize]);
-            if orient2d(a, b, c) <= 0.0 {
-                return Err(format!("triangle {:?} is not ccw", self.gtri(t as u32)));
-            }
-            if tr.inside() {
-                n_in += 1;
-                if tr.v.iter().any(|&v| v < 3) {
-                    return Err(format!("facet triangle {t} uses a temporary vertex"));
-                }
-            }
+            ensure!(orient2d(a, b, c) > 0.0, "triangle {g:?} not ccw");
+            n_in += tr.inside() as usize;
+            let ok = !tr.inside() || tr.v.iter().all(|&v| v >= 3);
+            ensure!(ok, "triangle {t} uses a temporary vertex");
             for i in 0..3 {
-                let (x, y) = (tr.v[nx(i)], tr.v[pv(i)]);
-                let r = tr.n[i];
+                let (x, y, r) = (tr.v[nx(i)], tr.v[pv(i)], tr.n[i]);
                 if r == NONE {
-                    if x >= 3 || y >= 3 {
-                        return Err(format!("triangle {t} edge {i} has no neighbour"));
-                    }
+                    ensure!(x < 3 && y < 3, "triangle {t}: no neighbour {i}");
                     continue;
                 }
                 let (u, j) = ((r / 3) as usize, (r % 3) as usize);
                 let ur = self.tris.get(u).ok_or("bad neighbour reference")?;
-                if ur.n[j] != (t * 3 + i) as u32 || ur.v[nx(j)] != y || ur.v[pv(j)] != x {
-                    return Err(format!("triangles {t} and {u} disagree on their edge"));
-                }
-                if tr.cons(i) != ur.cons(j) {
-                    return Err(format!("triangles {t}, {u}: constrained flag differs"));
-                }
-                if !tr.cons(i) && tr.inside() != ur.inside() {
-                    return Err(format!("facet boundary {t}|{u} not constrained"));
-                }
-                if tr.cons(i) && !tr.inside() && !ur.inside() {
-                    return Err(format!("constrained edge of {t} outside the facet"));
-                }
-                if tr.inside() && !tr.cons(i) && self.incircle(tr.v[i], x, y, ur.v[j]) {
-                    let (d, [a, b, c]) = (self.gid[ur.v[j] as usize], self.gtri(t as u32));
-                    return Err(format!(
-                        "not locally Delaunay: {d} in circle of {a}, {b}, {c}"
-                    ));
-                }
+                let ok = ur.n[j] == (t * 3 + i) as u32 && ur.v[nx(j)] == y && ur.v[pv(j)] == x;
+                ensure!(ok, "triangles {t}, {u} disagree");
+                let (cons, inside) = (tr.cons(i), tr.inside());
+                ensure!(cons == ur.cons(j), "constrained flag {t}|{u}");
+                let ok = cons || inside == ur.inside();
+                ensure!(ok, "unconstrained boundary {t}|{u}");
+                let ok = !cons || inside || ur.inside();
+                ensure!(ok, "constrained edge {t}|{u} outside");
+                let bad = inside && !cons && self.incircle(tr.v[i], x, y, ur.v[j]);
+                let d = self.gid[ur.v[j] as usize];
+                ensure!(!bad, "{d} in the circle of {g:?}");
             }
         }
-        if n_in != self.n_inside {
-            return Err(format!("{n_in} facet triangles, not {}", self.n_inside));
-        }
+        ensure!(n_in == self.n_inside, "facet triangle count");
         for v in 0..nv {
-            let t = self.vtri[v] as usize;
-            if self.tris.get(t).and_then(|tr| tr.find(v as u32)).is_none() {
-                return Err(format!("vertex {} has a stale triangle", self.gid[v]));
-            }
-            if v >= 3 && self.local.get(&self.gid[v]) != Some(&(v as u32)) {
-                return Err(format!("vertex {} missing from the id map", self.gid[v]));
-            }
+            let tr = self.tris.get(self.vtri[v] as usize);
+            let ok = tr.and_then(|tr| tr.find(v as u32)).is_some();
+            ensure!(ok, "vertex {} has a stale triangle", self.gid[v]);
+            let ok = v < 3 || self.local.get(&self.gid[v]) == Some(&(v as u32));
+            ensure!(ok, "vertex {} not in the id map", self.gid[v]);
         }
         if let Some(exp) = self.expected_area {
             let got = self.area();
-            if (got - exp).abs() > 1e-9 * exp.abs() {
-                return Err(format!("triangles cover area {got}, polygons have {exp}"));
-            }
+            let ok = (got - exp).abs() <= 1e-9 * exp.abs();
+            ensure!(ok, "triangles' area {got}, polygons' {exp}");
         }
         Ok(())
     }
@@ -1116,9 +1092,7 @@ impl FacetMesh {
             }
             cross.push((v1, v2));
             let r = tr.n[e];
-            if r == NONE {
-                return Err("internal: constraint left the super-triangle".into());
-            }
+            ensure!(r != NONE, "internal: constraint left the super-triangle");
             let (u, j, w) = (r / 3, (r % 3) as usize, self.apex(r));
             if w == b {
                 return Ok((b, cross));
@@ -1154,40 +1128,23 @@ impl FacetMesh {
             } else {
                 queue.push_back((x, y));
                 stall += 1;
-                if stall > queue.len() {
-                    return Err("internal: edge recovery stalled".into());
-                }
+                ensure!(stall <= queue.len(), "internal: edge recovery stalled");
             }
         }
         Ok(())
     }
 
-    /// Lawson flips over the whole triangulation (after edge recovery).
+    /// Lawson flips over the whole triangulation (after edge recovery). Flips reuse the two
+    /// triangle slots, so a stack of slots stays valid; a flipped pair is checked again.
     fn make_cdt(&mut self) -> Result<(), String> {
-        let mut stack = Vec::new();
-        for (t, tr) in self.tris.iter().enumerate() {
-            for i in 0..3 {
-                if !tr.cons(i) && tr.n[i] != NONE && ((t * 3 + i) as u32) < tr.n[i] {
-                    stack.push((tr.v[nx(i)], tr.v[pv(i)]));
-                }
-            }
-        }
+        let mut stack: Vec<u32> = (0..self.tris.len() as u32).collect();
         let mut budget = self.tris.len().saturating_mul(self.tris.len()) + 10_000;
-        while let Some((a, b)) = stack.pop() {
-            let Some((t, i)) = self.find_edge(a, b) else {
-                continue;
-            };
-            if !self.should_flip(t, i) {
-                continue;
+        while let Some(t) = stack.pop() {
+            if let Some(i) = (0..3).find(|&i| self.should_flip(t, i)) {
+                ensure!(budget > 0, "internal: too many flips");
+                budget -= 1;
+                stack.extend([t, self.flip_at(t, i)]);
             }
-            if budget == 0 {
-                return Err("internal: too many flips (is the facet planar?)".into());
-            }
-            budget -= 1;
-            let tr = self.tris[t as usize];
-            let (c, x, y, d) = (tr.v[i], tr.v[nx(i)], tr.v[pv(i)], self.apex(tr.n[i]));
-            self.flip_at(t, i);
-            stack.extend([(c, x), (x, d), (d, y), (y, c)]);
         }
         Ok(())
     }
