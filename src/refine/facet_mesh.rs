@@ -172,7 +172,7 @@ impl std::fmt::Display for SplitError {
 impl std::error::Error for SplitError {}
 
 /// A facet's constrained Delaunay triangulation; see the module documentation.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct FacetMesh {
     tris: Vec<Tri>,
     /// Local vertex -> global id (NONE for the 3 super-triangle vertices, locals 0..3).
@@ -254,10 +254,8 @@ impl FacetMesh {
         let (mut ids, mut seen) = (Vec::new(), FxHashMap::default());
         let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
         for &id in outer.iter().chain(&holes).flatten() {
-            let n = points.len();
-            let p = *points
-                .get(id as usize)
-                .ok_or(format!("vertex id {id} out of range ({n})"))?;
+            ensure!((id as usize) < points.len(), "vertex id {id} out of range");
+            let p = points[id as usize];
             check_coordinate(p).map_err(|e| format!("vertex {id} at {p}: {e}"))?;
             if seen.insert(id, ()).is_none() {
                 (lo, hi) = (lo.min(p), hi.max(p));
@@ -278,9 +276,7 @@ impl FacetMesh {
             .map(|p| (p, newell(points, p)))
             .max_by(|a, b| a.1.length_squared().total_cmp(&b.1.length_squared()))
             .ok_or("facet has no outer polygon with 3 or more vertices")?;
-        let k = (0..3)
-            .max_by(|&i, &j| nrm[i].abs().total_cmp(&nrm[j].abs()))
-            .unwrap();
+        let k = (0..3).fold(0, |k, i| if nrm[i].abs() > nrm[k].abs() { i } else { k });
         let ok = nrm[k] != 0.0 && nrm.is_finite();
         ensure!(ok, "outer polygon {best:?} has no area");
         let cyc = [(k + 1) % 3, (k + 2) % 3];
@@ -289,11 +285,8 @@ impl FacetMesh {
             DVec2::new(p[cyc[0]], p[cyc[1]])
         });
         ensure!(w != 0.0, "polygon {best:?} degenerate/not simple");
-        let (axes, s) = if w > 0.0 {
-            (cyc, 1.0)
-        } else {
-            ([cyc[1], cyc[0]], -1.0)
-        };
+        let s = w.signum();
+        let axes = if s > 0.0 { cyc } else { [cyc[1], cyc[0]] };
         let normal = nrm.normalize() * if nrm[k] * s < 0.0 { -1.0 } else { 1.0 };
         // The lifting point: above the polygon's extreme vertex, on the normal's side.
         let n = best.len();
@@ -304,10 +297,18 @@ impl FacetMesh {
         ensure!(ok, "polygon {best:?} is too far from planar");
 
         let mut fm = FacetMesh {
+            tris: Vec::with_capacity(2 * ids.len() + 8),
+            gid: Vec::new(),
+            p3: Vec::new(),
+            p2: Vec::new(),
+            vtri: Vec::new(),
+            local: FxHashMap::default(),
             axes,
             normal,
             eye,
-            ..Default::default()
+            n_inside: 0,
+            expected_area: None,
+            hint: 0,
         };
         // Super-triangle well around the bounding box, its vertices put (in float) on the plane
         // through v0 so that the lifting treats them like the others.
@@ -326,9 +327,7 @@ impl FacetMesh {
             match fm.walk(fm.proj(p)) {
                 Loc::Vertex(t, i) => {
                     let other = fm.gid[fm.tris[t as usize].v[i] as usize];
-                    return Err(format!(
-                        "vertices {other} and {id} coincide in projection ({p})"
-                    ));
+                    return Err(format!("vertices {other} and {id} coincide ({p})"));
                 }
                 Loc::Outside => return Err(format!("internal: vertex {id} off super-triangle")),
                 loc => {
@@ -355,11 +354,8 @@ impl FacetMesh {
                 for e in fm.recover(loc(&fm, a), loc(&fm, b))?.windows(2) {
                     let (t, i) = fm.find_edge(e[0], e[1]).unwrap();
                     let left = fm.tris[t as usize].v[nx(i)] == e[0];
-                    seeds.push(if left == (w > 0.0) {
-                        t
-                    } else {
-                        fm.tris[t as usize].n[i] / 3
-                    });
+                    let other = fm.tris[t as usize].n[i] / 3;
+                    seeds.push(if left == (w > 0.0) { t } else { other });
                 }
             }
         }
@@ -384,21 +380,15 @@ impl FacetMesh {
         for tr in &fm.tris {
             for i in (0..3).filter(|&i| tr.cons(i) && !tr.inside()) {
                 if !fm.tris[(tr.n[i] / 3) as usize].inside() {
-                    let (a, b) = (fm.gid[tr.v[nx(i)] as usize], fm.gid[tr.v[pv(i)] as usize]);
-                    return Err(format!("polygon edge ({a}, {b}) lies outside the facet"));
+                    let e = fm.edge_ids(tr, i);
+                    return Err(format!("polygon edge {e:?} lies outside the facet"));
                 }
             }
         }
         fm.make_cdt()?;
         fm.hint = fm.tris.iter().position(|t| t.inside()).unwrap() as u32;
         if hole_points.is_empty() {
-            let area = |p: &Vec<u32>| {
-                if p.len() < 3 {
-                    0.0
-                } else {
-                    0.5 * newell(points, p).length()
-                }
-            };
+            let area = |p: &Vec<u32>| 0.5 * newell(points, p).length(); // 0 for 1 or 2 vertices
             let a: f64 = outer.iter().map(area).sum::<f64>() - holes.iter().map(area).sum::<f64>();
             fm.expected_area = Some(a);
         }
@@ -431,11 +421,8 @@ impl FacetMesh {
         };
         let tr = self.tris[t as usize];
         if i < 3 && tr.cons(i) {
-            let (a, b) = (
-                self.gid[tr.v[nx(i)] as usize],
-                self.gid[tr.v[pv(i)] as usize],
-            );
-            return Err(InsertError::OnConstrainedEdge(a.min(b), a.max(b)));
+            let [a, b] = self.edge_ids(&tr, i);
+            return Err(InsertError::OnConstrainedEdge(a, b));
         }
         if !tr.inside() {
             return Err(InsertError::Outside);
@@ -560,11 +547,7 @@ impl FacetMesh {
         for (t, tr) in self.tris.iter().enumerate() {
             for i in 0..3 {
                 if tr.cons(i) && (t as u32) * 3 + (i as u32) < tr.n[i] {
-                    let (a, b) = (
-                        self.gid[tr.v[nx(i)] as usize],
-                        self.gid[tr.v[pv(i)] as usize],
-                    );
-                    out.push([a.min(b), a.max(b)]);
+                    out.push(self.edge_ids(tr, i));
                 }
             }
         }
@@ -1009,11 +992,14 @@ impl FacetMesh {
 
     /// orient2d of edge `i` of `tr` (as the triangle runs) and q: > 0 on the triangle's side.
     fn side(&self, tr: &Tri, i: usize, q: DVec2) -> f64 {
-        orient2d(
-            self.p2[tr.v[nx(i)] as usize],
-            self.p2[tr.v[pv(i)] as usize],
-            q,
-        )
+        let [a, b] = [nx(i), pv(i)].map(|k| self.p2[tr.v[k] as usize]);
+        orient2d(a, b, q)
+    }
+
+    /// Global ids of edge `i` of `tr`, smaller first.
+    fn edge_ids(&self, tr: &Tri, i: usize) -> [u32; 2] {
+        let [a, b] = [nx(i), pv(i)].map(|k| self.gid[tr.v[k] as usize]);
+        [a.min(b), a.max(b)]
     }
 
     fn classify(t: u32, zero: [bool; 3]) -> Loc {
@@ -1035,9 +1021,7 @@ impl FacetMesh {
             if !cross.is_empty() {
                 self.flip_out(s, e, cross)?;
             }
-            let (t, i) = self
-                .find_edge(s, e)
-                .ok_or("internal: recovered edge missing")?;
+            let (t, i) = self.find_edge(s, e).ok_or("internal: lost edge")?;
             self.tris[t as usize].f |= 1 << i;
             let r = self.tris[t as usize].n[i];
             self.tris[(r / 3) as usize].f |= 1 << (r % 3);
@@ -1096,9 +1080,7 @@ impl FacetMesh {
         let mut queue: VecDeque<(u32, u32)> = cross.into();
         let mut stall = 0;
         while let Some((x, y)) = queue.pop_front() {
-            let (t, i) = self
-                .find_edge(x, y)
-                .ok_or("internal: crossing edge vanished")?;
+            let (t, i) = self.find_edge(x, y).ok_or("internal: lost edge")?;
             let tr = self.tris[t as usize];
             let (c, d) = (tr.v[i], self.apex(tr.n[i]));
             if self.convex(c, tr.v[nx(i)], tr.v[pv(i)], d) {
