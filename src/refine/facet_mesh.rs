@@ -33,7 +33,7 @@
 //! visibility walk (Devillers et al., terminates in any triangulation) and "is p in the facet"
 //! is "is the triangle found inside". Triangles are never deleted (every operation splits or
 //! flips), so there is no free list. Construction: incremental Delaunay insertion of the polygon
-//! vertices (Lawson flips), recovery of each polygon edge by Sloan's flip algorithm (a vertex
+//! vertices in BRIO order (Lawson flips), recovery of each polygon edge by Sloan's flip algorithm (a vertex
 //! lying exactly on the edge splits it), flood fill from the super-triangle, from the inner side
 //! of hole polygons and from hole points (bounded by constrained edges), then Lawson flips to the
 //! constrained Delaunay triangulation. `insert`/`split_edge` cost a walk plus O(flips).
@@ -53,6 +53,7 @@
 //!   `validate` then reports it. A rounding error off the plane (float circumcentres and
 //!   midpoints) did not trigger this in randomized tests.
 
+use crate::delaunay::hilbert::brio_order;
 use crate::geom::{check_coordinate, insphere, orient3d};
 use glam::{DVec2, DVec3};
 use rustc_hash::FxHashMap;
@@ -329,7 +330,13 @@ impl FacetMesh {
         }
         fm.new_tri();
         fm.put(0, [0, 1, 2], 0);
-        for &id in &ids {
+        // BRIO + Hilbert order: points along a polygon in order (e.g. a circle) would cost O(n)
+        // flips each; this keeps construction near O(n log n).
+        let order = brio_order(
+            &ids.iter().map(|&i| points[i as usize]).collect::<Vec<_>>(),
+            1,
+        );
+        for id in order.into_iter().map(|k| ids[k as usize]) {
             let p = points[id as usize];
             match fm.walk(fm.proj(p)) {
                 Loc::Vertex(t, i) => {
