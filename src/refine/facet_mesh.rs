@@ -507,10 +507,8 @@ impl FacetMesh {
         }
         let removed = vec![self.gtri(t), self.gtri(u)];
         self.flip_at(t, i);
-        Some(Change {
-            removed,
-            added: vec![self.gtri(t), self.gtri(u)],
-        })
+        let added = vec![self.gtri(t), self.gtri(u)];
+        Some(Change { removed, added })
     }
 
     /// The facet triangle holding p (projected on the facet plane; closed triangles, a point on
@@ -519,14 +517,10 @@ impl FacetMesh {
         let t = match self.walk(self.proj(p)) {
             Loc::Outside => return None,
             Loc::In(t) => t,
-            Loc::Edge(t, i) => {
-                let u = self.tris[t as usize].n[i];
-                if self.tris[t as usize].inside() || u == NONE {
-                    t
-                } else {
-                    u / 3
-                }
-            }
+            Loc::Edge(t, i) => match self.tris[t as usize].n[i] {
+                u if u != NONE && !self.tris[t as usize].inside() => u / 3,
+                _ => t,
+            },
             Loc::Vertex(t, i) => {
                 let v = self.tris[t as usize].v[i];
                 self.find_in_star(v, |s, _| self.tris[s as usize].inside())
@@ -539,10 +533,7 @@ impl FacetMesh {
     /// All triangles of the facet (global ids, ccw about [`FacetMesh::normal`], smallest id
     /// first).
     pub fn triangles(&self) -> Vec<[u32; 3]> {
-        (0..self.tris.len() as u32)
-            .filter(|&t| self.tris[t as usize].inside())
-            .map(|t| self.gtri(t))
-            .collect()
+        self.facet_tris().map(|t| self.gtri(t)).collect()
     }
 
     /// Number of triangles of the facet.
@@ -610,13 +601,11 @@ impl FacetMesh {
 
     /// Sum of the 3D areas of the facet triangles.
     pub fn area(&self) -> f64 {
-        (0..self.tris.len())
-            .filter(|&t| self.tris[t].inside())
-            .map(|t| {
-                let [a, b, c] = self.tris[t].v.map(|v| self.p3[v as usize]);
-                0.5 * (b - a).cross(c - a).length()
-            })
-            .sum()
+        let area = |t: u32| {
+            let [a, b, c] = self.tris[t as usize].v.map(|v| self.p3[v as usize]);
+            0.5 * (b - a).cross(c - a).length()
+        };
+        self.facet_tris().map(area).sum()
     }
 
     /// Full consistency check (for tests; O(n)): adjacency symmetry, ccw orientation of every
@@ -674,6 +663,11 @@ impl FacetMesh {
     }
 
     // ---------------------------------------------------------------- internals
+
+    /// Slots of the facet's triangles.
+    fn facet_tris(&self) -> impl Iterator<Item = u32> + '_ {
+        (0..self.tris.len() as u32).filter(|&t| self.tris[t as usize].inside())
+    }
 
     fn proj(&self, p: DVec3) -> DVec2 {
         DVec2::new(p[self.axes[0]], p[self.axes[1]])
@@ -1254,7 +1248,7 @@ mod tests {
     }
 
     #[test]
-    fn l_shape() {
+    fn l_shape_and_holes() {
         let pts = xy(&[0., 0., 2., 0., 2., 1., 1., 1., 1., 2., 0., 2.]);
         let mut m = FacetMesh::new(&pts, &[(0..6).collect()], &[], &[]).unwrap();
         m.validate().unwrap();
@@ -1264,10 +1258,7 @@ mod tests {
         assert_eq!(m.insert(10, p(1.5, 1.5)), Err(InsertError::Outside));
         drive(&mut m, 400, 0.2, 7, |x, y| p(2.0 * x, 2.0 * y));
         assert!(m.num_vertices() > 200 && m.num_vertices() < 400);
-    }
-
-    #[test]
-    fn square_with_holes() {
+        // square with a square hole given as a polygon of either winding
         let pts = xy(&SQUARE_HOLE);
         for hole in [vec![4, 5, 6, 7], vec![7, 6, 5, 4]] {
             let mut m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3]], &[hole], &[]).unwrap();
