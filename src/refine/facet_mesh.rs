@@ -453,7 +453,7 @@ impl FacetMesh {
     /// Splits the edge (a, b) (normally a subsegment) at vertex `id` placed at `p`, a point
     /// near the segment (a float midpoint: need not be exactly on it). The edge is replaced by
     /// a-p and p-b, both constrained if ab was; the one or two adjacent facet triangles are split,
-    /// then Lawson flips restore the constrained Delaunay property.
+    /// then Lawson flips restore the constrained Delaunay property. On error nothing changes.
     pub fn split_edge(&mut self, a: u32, b: u32, id: u32, p: DVec3) -> Result<Change, SplitError> {
         if id == NONE || self.local.contains_key(&id) {
             return Err(SplitError::IdInUse(id));
