@@ -189,6 +189,7 @@ impl Domain {
             .subsegs
             .get(&key)
             .ok_or_else(|| MeshError::Internal(format!("({a}, {b}) is not a subsegment")))?;
+        let p = self.splittable_point(seg, a, b, p);
         let hint = self.dt.vertex_tet(a);
         let id = self.insert_point(p, VertexKind::Segment(seg), hint)?;
         self.subsegs.remove(&key);
@@ -203,6 +204,48 @@ impl Domain {
             self.apply_change(f, &change);
         }
         Ok(id)
+    }
+
+    /// A float split point is a rounding error off its segment; next to a facet triangle whose
+    /// apex is nearly on the segment that error can flip the triangle's orientation. Returns
+    /// `p` if no facet of segment `seg` would see a flipped triangle, else a nearby point on
+    /// ab that none does (or `p` when none is found; the facet then reports the problem).
+    fn splittable_point(&self, seg: u32, a: u32, b: u32, p: DVec3) -> DVec3 {
+        let (pa, pb) = (self.point(a), self.point(b));
+        let ok = |q: DVec3| {
+            self.segments[seg as usize].facets.iter().all(|&f| {
+                let fm = &self.facets[f as usize];
+                let n = fm.normal().abs();
+                let axis = if n.x >= n.y && n.x >= n.z {
+                    0
+                } else if n.y >= n.z {
+                    1
+                } else {
+                    2
+                };
+                let apexes = fm.opposite(a, b).into_iter().flatten().flatten();
+                apexes.into_iter().all(|c| {
+                    let pc = self.point(c);
+                    let s = orient_dropping(pa, pb, pc, axis);
+                    s != 0.0
+                        && orient_dropping(pa, q, pc, axis).signum() == s.signum()
+                        && orient_dropping(q, pb, pc, axis).signum() == s.signum()
+                })
+            })
+        };
+        if ok(p) {
+            return p;
+        }
+        let len2 = pa.distance_squared(pb);
+        let t0 = (p - pa).dot(pb - pa) / len2;
+        for k in 1..=32 {
+            let dt = 0.004 * k as f64 * if k % 2 == 0 { 1.0 } else { -1.0 };
+            let q = pa + (pb - pa) * (t0 + dt).clamp(0.05, 0.95);
+            if ok(q) {
+                return q;
+            }
+        }
+        p
     }
 
     /// Inserts `p` (inside facet `f`) into the 3D triangulation and the facet's triangulation.
@@ -243,4 +286,11 @@ fn acute_segment_vertices(points: &[DVec3], segments: &[Segment]) -> FxHashSet<u
         }
     }
     acute
+}
+
+/// Exact orientation of the projection of a, b, c dropping coordinate `axis` (sign only).
+fn orient_dropping(a: DVec3, b: DVec3, c: DVec3, axis: usize) -> f64 {
+    let (i, j) = ((axis + 1) % 3, (axis + 2) % 3);
+    let lift = |p: DVec3| DVec3::new(p[i], p[j], 0.0);
+    crate::geom::orient3d(lift(a), lift(b), lift(c), DVec3::Z)
 }
