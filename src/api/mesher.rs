@@ -37,7 +37,8 @@ pub type ProgressFn = Box<dyn FnMut(f64, usize) -> bool + Send>;
 /// Builder arguments are checked when given (coordinates finite and within
 /// `geom::MAX_COORD`, vertex ids below the number of vertices added so far, parameter names and
 /// ranges); the domain as a whole (planarity, intersections) is checked by [`Mesher::refine`].
-/// Every setter discards a previous result: outputs always match the current input and settings.
+/// Every setter of the domain, the parameters or the spacing discards a previous result: outputs
+/// always match the current input and settings.
 #[derive(Default)]
 pub struct Mesher {
     input: PlcInput,
@@ -247,13 +248,13 @@ impl Mesher {
         f: F,
     ) -> &mut Self {
         self.progress = Some(Box::new(f));
-        self.changed()
+        self
     }
 
     /// Removes the progress callback.
     pub fn clear_progress(&mut self) -> &mut Self {
         self.progress = None;
-        self.changed()
+        self
     }
 
     /// Meshes the domain with the stored spacing and progress callback.

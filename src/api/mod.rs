@@ -8,6 +8,10 @@
 //! - [`MeshOutput`], [`QualityFields`] (`output.rs`): the result and its writing with per-tet
 //!   quality as cell data.
 //! - [`Error`] (`error.rs`): the one error type.
+//!
+//! No `unsafe` here: the C ABI's raw pointers stay in `ffi`.
+
+#![deny(unsafe_code)]
 
 mod error;
 mod mesher;
