@@ -184,7 +184,8 @@ impl Delaunay {
             let v = self.tets[t as usize].v;
             let face = FACE[i as usize].map(|k| v[k]);
             let tag = self.tags.get(t as usize).copied().unwrap_or(0);
-            s.faces.push((face, self.tets[t as usize].n[i as usize], tag));
+            s.faces
+                .push((face, self.tets[t as usize].n[i as usize], tag));
         }
         for &t in &s.cavity {
             self.free_tet(t);

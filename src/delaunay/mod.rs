@@ -279,6 +279,12 @@ impl Delaunay {
     pub fn set_tag(&mut self, t: u32, tag: u32) {
         self.tags[t as usize] = tag;
     }
+    /// A finite tet whose closure contains `p`, or a hull tet with `p` beyond its hull face.
+    pub fn locate_point(&mut self, p: DVec3, hint: Option<u32>) -> u32 {
+        let hint = hint.filter(|&t| self.is_alive(t)).unwrap_or(self.last);
+        self.locate(p, hint)
+    }
+
     /// Tets created by the last successful insertion (all incident to the new vertex).
     pub fn last_created(&self) -> &[u32] {
         &self.scratch.created
@@ -317,15 +323,14 @@ impl Delaunay {
 
     /// The tets (one or two) having face abc, with the local index of their fourth vertex.
     pub fn find_face(&self, a: u32, b: u32, c: u32) -> Option<[(u32, usize); 2]> {
-        let t = self
-            .vertex_star(a)
-            .into_iter()
-            .find(|&t| {
-                let v = self.tets[t as usize].v;
-                v.contains(&b) && v.contains(&c)
-            })?;
+        let t = self.vertex_star(a).into_iter().find(|&t| {
+            let v = self.tets[t as usize].v;
+            v.contains(&b) && v.contains(&c)
+        })?;
         let v = self.tets[t as usize].v;
-        let i = (0..4).find(|&i| v[i] != a && v[i] != b && v[i] != c).unwrap();
+        let i = (0..4)
+            .find(|&i| v[i] != a && v[i] != b && v[i] != c)
+            .unwrap();
         let r = self.tets[t as usize].n[i];
         Some([(t, i), (r >> 2, (r & 3) as usize)])
     }

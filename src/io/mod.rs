@@ -1,12 +1,41 @@
 //! Readers and writers. No meshing logic lives here.
 //!
-//! STUB: signatures are fixed; the io helper fills them in.
+//! One module per format, each documenting the subset it supports:
+//!
+//! | format | read | write | module |
+//! |---|---|---|---|
+//! | TetGen `.poly`, `.smesh` (+ `.node`) | domain ([`PlcInput`]) | | [`poly`] |
+//! | `.off` | domain | | [`off`] |
+//! | `.stl` (ASCII, binary) | domain | | [`stl`] |
+//! | medit `.mesh` | mesh ([`TetMesh`]) | mesh | [`medit`] |
+//! | VTK `.vtu` | mesh + cell fields | mesh + cell fields | [`vtu`] |
+//! | gmsh `.msh` 4.1 | mesh | mesh | [`gmsh`] |
+//! | TetGen `.node`/`.ele`/`.face` | mesh | mesh | [`tetgen`] |
+//!
+//! [`read_plc`], [`read_mesh`] and [`write_mesh`] choose the format by extension
+//! (case-insensitive). Errors are [`IoError`]s naming the file and, for text formats, the
+//! 1-based line. Floats are written in shortest round-trip form, so a written mesh reads back
+//! bit for bit. Marker conventions: a `.poly`/`.smesh` facet without a marker gets 1; `.off`
+//! and `.stl` facets get their 1-based facet index (after the optional coplanar merge); mesh
+//! readers use 0 for a missing region or marker.
 
 use crate::mesh::TetMesh;
 use crate::plc::PlcInput;
 use std::path::Path;
 
+pub mod coplanar;
+pub mod gmsh;
+pub mod medit;
+pub mod off;
 pub mod points;
+pub mod poly;
+pub mod stl;
+pub mod tetgen;
+mod text;
+pub mod vtu;
+
+#[cfg(test)]
+mod tests;
 
 /// An I/O or parse failure, naming the file and (when known) the 1-based line.
 #[derive(Debug, Clone, PartialEq)]
@@ -40,14 +69,77 @@ pub struct ReadOptions {
     pub merge_coplanar: bool,
 }
 
+/// Extensions accepted by [`read_plc`].
+pub const PLC_EXTENSIONS: &[&str] = &["poly", "smesh", "off", "stl"];
+/// Extensions accepted by [`write_mesh`] and [`read_mesh`].
+pub const MESH_EXTENSIONS: &[&str] = &["vtu", "mesh", "msh", "node", "ele", "face"];
+
+/// The lower-cased extension of `path`, or an error listing the supported ones.
+fn extension(path: &Path, supported: &[&str], what: &str) -> Result<String, IoError> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase())
+        .unwrap_or_default();
+    if supported.contains(&ext.as_str()) {
+        return Ok(ext);
+    }
+    let list = supported
+        .iter()
+        .map(|e| format!(".{e}"))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let found = if ext.is_empty() {
+        "no extension".to_string()
+    } else {
+        format!("extension '.{ext}'")
+    };
+    Err(IoError {
+        path: path.display().to_string(),
+        line: None,
+        message: format!("unsupported {what} format ({found}); supported: {list}"),
+    })
+}
+
 /// Reads a domain (.poly, .smesh, .off, .stl), format chosen by extension.
 pub fn read_plc(path: &Path, options: &ReadOptions) -> Result<PlcInput, IoError> {
-    let _ = (path, options);
-    todo!()
+    match extension(path, PLC_EXTENSIONS, "domain")?.as_str() {
+        "poly" => poly::read_poly(path),
+        "smesh" => poly::read_smesh(path),
+        "off" => off::read_off(path, options),
+        _ => stl::read_stl(path, options),
+    }
 }
 
 /// Writes a mesh (.vtu, .mesh, .msh, .node/.ele/.face), format chosen by extension.
+///
+/// `cell_fields` are written as cell data by `.vtu` only; the other formats have no place for
+/// them and ignore them (their lengths are still checked). A TetGen extension writes all three
+/// of `X.node`, `X.ele` and `X.face`.
 pub fn write_mesh(path: &Path, mesh: &TetMesh, cell_fields: &[CellField]) -> Result<(), IoError> {
-    let _ = (path, mesh, cell_fields);
-    todo!()
+    let ext = extension(path, MESH_EXTENSIONS, "mesh")?;
+    let lens: Vec<(&str, usize)> = cell_fields
+        .iter()
+        .map(|f| (f.name, f.values.len()))
+        .collect();
+    text::check_mesh(mesh, &lens).map_err(|e| text::with_path(e, path))?;
+    match ext.as_str() {
+        "vtu" => vtu::write_vtu(path, mesh, cell_fields),
+        "mesh" => medit::write_medit(path, mesh),
+        "msh" => gmsh::write_msh(path, mesh),
+        _ => tetgen::write_tetgen(path, mesh),
+    }
+}
+
+/// Reads a mesh (.mesh, .vtu, .msh, .node/.ele/.face), format chosen by extension.
+///
+/// A medit `.mesh` is the "existing mesh" input. A `.vtu` holds no boundary triangles, and its
+/// cell fields other than `region` are dropped here (use [`vtu::read_vtu`] to get them).
+pub fn read_mesh(path: &Path) -> Result<TetMesh, IoError> {
+    match extension(path, MESH_EXTENSIONS, "mesh")?.as_str() {
+        "vtu" => vtu::read_vtu(path).map(|d| d.mesh),
+        "mesh" => medit::read_medit(path),
+        "msh" => gmsh::read_msh(path),
+        _ => tetgen::read_tetgen(path),
+    }
 }

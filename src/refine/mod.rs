@@ -1,9 +1,18 @@
 //! Li's REMOVE-SLIVER refinement (the paper, section 3) on top of the Delaunay kernel:
 //! boundary recovery (empty encroachment), domain marking, then cleaning of size-bad,
 //! radius-edge-bad and sliver tets from random points of picking regions.
-//!
-//! STUB: the public interface (`Params`, `Spacing`, `Report`, `MeshError`, `mesh`) is fixed;
-//! bodies are being written.
+
+mod domain;
+pub mod existing;
+pub mod facet_mesh;
+mod mark;
+mod output;
+mod quality;
+mod recover;
+pub mod report;
+mod spacing;
+
+pub use spacing::AutoSpacing;
 
 use crate::mesh::TetMesh;
 use crate::plc::PlcInput;
@@ -16,6 +25,10 @@ pub struct Params {
     pub rho0: f64,
     /// Sliver bound sigma0 = V / L^3 (regular tet: 0.1179).
     pub sigma0: f64,
+    /// Practical sliver bound in degrees: a tet whose smallest dihedral angle is below it is
+    /// treated as a sliver too. sigma = V / L^3 uses the shortest edge, so a flat tet with one
+    /// short edge can pass any sigma0; the dihedral angle catches it. 0 disables.
+    pub min_dihedral: f64,
     /// Picking-region radius factor: points are drawn from the ball (c, delta * R).
     pub delta: f64,
     /// Small-sliver radius factor: a new sliver with circumradius <= b * R rejects the point.
@@ -37,6 +50,7 @@ impl Default for Params {
         Params {
             rho0: 2.0,
             sigma0: 0.02,
+            min_dihedral: 15.0,
             delta: 0.3,
             b: 4.0,
             size_factor: 1.0,
@@ -45,6 +59,47 @@ impl Default for Params {
             max_tries: 20,
             refine: true,
         }
+    }
+}
+
+impl Params {
+    /// Checks ranges; the message names the parameter.
+    pub fn check(&self) -> Result<(), String> {
+        let positive = [
+            ("rho0", self.rho0),
+            ("delta", self.delta),
+            ("b", self.b),
+            ("size_factor", self.size_factor),
+        ];
+        for (name, v) in positive {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(format!(
+                    "parameter {name} = {v} must be finite and positive"
+                ));
+            }
+        }
+        if !(self.sigma0.is_finite() && self.sigma0 >= 0.0) {
+            return Err(format!(
+                "parameter sigma0 = {} must be finite and >= 0",
+                self.sigma0
+            ));
+        }
+        if !(self.min_dihedral.is_finite() && (0.0..70.5).contains(&self.min_dihedral)) {
+            return Err(format!(
+                "parameter min_dihedral = {} must be in [0, 70.5) degrees",
+                self.min_dihedral
+            ));
+        }
+        if self.delta >= 1.0 {
+            return Err(format!("parameter delta = {} must be < 1", self.delta));
+        }
+        if self.rho0 < 0.7 {
+            return Err(format!(
+                "parameter rho0 = {} is below what a tet can reach (0.612)",
+                self.rho0
+            ));
+        }
+        Ok(())
     }
 }
 
@@ -147,6 +202,52 @@ pub fn mesh(
     spacing: Option<&dyn Spacing>,
     progress: Option<Progress>,
 ) -> Result<(TetMesh, Report), MeshError> {
-    let _ = (input, params, spacing, progress);
-    Err(MeshError::Internal("not implemented yet".into()))
+    let start = std::time::Instant::now();
+    params.check().map_err(MeshError::InvalidInput)?;
+    crate::plc::validate(input).map_err(|e| MeshError::InvalidInput(e.to_string()))?;
+    let mut dom = domain::Domain::new(input)?;
+    let mut budget = recover::MAX_RECOVERY_SPLITS.min(params.max_vertices.saturating_mul(4));
+    dom.recover_boundary(&mut budget)?;
+    let regions = dom.mark_domain(input)?;
+    let seconds_recovery = start.elapsed().as_secs_f64();
+    let auto;
+    let spacing: &dyn Spacing = match spacing {
+        Some(s) => s,
+        None => {
+            auto = spacing::AutoSpacing::from_boundary(&dom);
+            &auto
+        }
+    };
+    let mut gave_up = 0;
+    let mut stop_reason = None;
+    if params.refine {
+        let mut noop = |_: f64, _: usize| true;
+        let progress: &mut dyn FnMut(f64, usize) -> bool = match progress {
+            Some(p) => p,
+            None => &mut noop,
+        };
+        let max_v = params.max_vertices.max(1) as f64;
+        let mut on_step = |n: usize| progress((n as f64 / max_v).min(1.0), n);
+        dom.created_log.clear();
+        let mut r = quality::Refiner::new(&mut dom, params, spacing, &regions);
+        r.run(&mut on_step)?;
+        gave_up = r.gave_up;
+        stop_reason = r.stop_reason.take();
+    }
+    let seconds_refinement = start.elapsed().as_secs_f64() - seconds_recovery;
+    let mesh = dom.to_mesh(&regions);
+    let mut report = report::measure(&mesh, spacing, params)?;
+    report.seconds_recovery = seconds_recovery;
+    report.seconds_refinement = seconds_refinement;
+    report.seconds_total = start.elapsed().as_secs_f64();
+    report.n_acute_angles = dom.acute_vertices.len();
+    report.n_bad_near_acute = gave_up;
+    report.complete = stop_reason.is_none() && (gave_up == 0 || !params.refine);
+    if stop_reason.is_none() && gave_up > 0 {
+        stop_reason = Some(format!(
+            "{gave_up} bad tets left near small input angles (their fix needed ever smaller boundary splits)"
+        ));
+    }
+    report.stop_reason = stop_reason;
+    Ok((mesh, report))
 }

@@ -1,0 +1,57 @@
+//! Measures what (rho0, sigma0, delta, b) combinations reach on the acute-free models and what
+//! they cost; prints a Markdown table (docs/parameters.md holds a run of it).
+//!
+//!     cargo run --release --example param_study [size]
+
+use slivermesh::io::{read_plc, ReadOptions};
+use slivermesh::refine::{mesh, ConstantSpacing, Params};
+use std::path::PathBuf;
+
+fn main() {
+    let size: f64 = std::env::args()
+        .nth(1)
+        .map_or(0.08, |s| s.parse().expect("size"));
+    let models = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/models");
+    let inputs = [
+        "poly/cube.poly",
+        "poly/lshape.poly",
+        "poly/two_materials.poly",
+        "poly/drilled_block.poly",
+    ];
+    let combos: &[(f64, f64, f64, f64)] = &[
+        (2.0, 0.0, 0.3, 4.0),
+        (2.0, 0.01, 0.3, 4.0),
+        (2.0, 0.02, 0.3, 4.0),
+        (2.0, 0.03, 0.3, 4.0),
+        (2.0, 0.04, 0.3, 4.0),
+        (2.0, 0.05, 0.3, 4.0),
+        (1.5, 0.03, 0.3, 4.0),
+        (2.0, 0.03, 0.1, 4.0),
+        (2.0, 0.03, 0.5, 4.0),
+        (2.0, 0.03, 0.3, 2.0),
+        (2.0, 0.03, 0.3, 8.0),
+    ];
+    println!("size h = {size} (R <= h)\n");
+    println!("| model | rho0 | sigma0 | delta | b | vertices | tets | max rho | min sigma | min dihedral | complete | seconds |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for rel in inputs {
+        let input = read_plc(&models.join(rel), &ReadOptions::default()).expect("read");
+        for &(rho0, sigma0, delta, b) in combos {
+            let params = Params {
+                rho0,
+                sigma0,
+                delta,
+                b,
+                ..Params::default()
+            };
+            let h = ConstantSpacing(size);
+            match mesh(&input, &params, Some(&h), None) {
+                Ok((_, r)) => println!(
+                    "| {rel} | {rho0} | {sigma0} | {delta} | {b} | {} | {} | {:.3} | {:.4} | {:.2} | {} | {:.2} |",
+                    r.n_vertices, r.n_tets, r.max_rho, r.min_sigma, r.min_dihedral_deg, r.complete, r.seconds_total
+                ),
+                Err(e) => println!("| {rel} | {rho0} | {sigma0} | {delta} | {b} | error: {e} |||||||"),
+            }
+        }
+    }
+}

@@ -1,0 +1,380 @@
+//! Merging edge-adjacent, exactly coplanar facets of a surface (.off/.stl) into polygon facets.
+//!
+//! Two facets are merged when they share an edge used by exactly those two facets, traversed in
+//! opposite directions (a consistently oriented surface), every vertex of one lies exactly on
+//! the plane of the other (`geom::orient3d == 0`, exact) and their normals point the same way.
+//! Merging is transitive, so each group is a connected, flat, edge-connected patch.
+//!
+//! Each group's boundary is computed by cancelling its interior edges (an edge used in both
+//! directions inside the group). The boundary edges are chained into loops: the loop whose
+//! signed area along the group normal is positive becomes the facet's polygon, the others
+//! (clockwise: inner boundaries) become `hole_polygons`, in the order they were traced.
+//! Collinear intermediate vertices are kept: they are PLC vertices anyway.
+//!
+//! A group is left unmerged (its facets are kept as they were) when its boundary is not a set of
+//! simple loops: a vertex with two outgoing boundary edges (patches touching at a vertex), or
+//! not exactly one outer loop. Facets with several polygons, with holes, or that are not planar
+//! or are degenerate (all vertices collinear) are never merged.
+//!
+//! Markers: every resulting facet gets marker = its 1-based index in the new facet list; facets
+//! keep the order of their first member, so the numbering is deterministic.
+
+use crate::geom::orient3d;
+use crate::plc::{Facet, PlcInput};
+use glam::DVec3;
+use rustc_hash::FxHashMap;
+
+/// Merges coplanar neighbouring facets of `plc` in place (see the module doc) and renumbers
+/// all facet markers 1, 2, ... in facet order.
+pub fn merge_coplanar_facets(plc: &mut PlcInput) {
+    let verts = &plc.vertices;
+    let facets = std::mem::take(&mut plc.facets);
+    let planes: Vec<Option<Plane>> = facets.iter().map(|f| Plane::of(f, verts)).collect();
+
+    // Undirected edge -> uses (facet, forward).
+    let mut edges: FxHashMap<(u32, u32), Vec<(usize, bool)>> = FxHashMap::default();
+    for (fi, f) in facets.iter().enumerate() {
+        if planes[fi].is_none() {
+            continue;
+        }
+        let p = &f.polygons[0];
+        for i in 0..p.len() {
+            let (u, v) = (p[i], p[(i + 1) % p.len()]);
+            let key = (u.min(v), u.max(v));
+            edges.entry(key).or_default().push((fi, u < v));
+        }
+    }
+
+    let mut uf = UnionFind::new(facets.len());
+    let mut keys: Vec<&(u32, u32)> = edges.keys().collect();
+    keys.sort_unstable();
+    for key in keys {
+        let uses = &edges[key];
+        if uses.len() != 2 {
+            continue;
+        }
+        let ((f, df), (g, dg)) = (uses[0], uses[1]);
+        if f == g || df == dg || uf.find(f) == uf.find(g) {
+            continue;
+        }
+        let (pf, pg) = match (&planes[f], &planes[g]) {
+            (Some(a), Some(b)) => (a, b),
+            _ => continue,
+        };
+        if pf.normal.dot(pg.normal) <= 0.0 {
+            continue;
+        }
+        let coplanar = facets[g].polygons[0]
+            .iter()
+            .all(|&v| pf.contains(verts[v as usize]));
+        if coplanar {
+            uf.union(f, g);
+        }
+    }
+
+    // Groups in order of their first facet.
+    let mut group_of_root: FxHashMap<usize, usize> = FxHashMap::default();
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    for fi in 0..facets.len() {
+        let r = uf.find(fi);
+        let gi = *group_of_root.entry(r).or_insert_with(|| {
+            groups.push(Vec::new());
+            groups.len() - 1
+        });
+        groups[gi].push(fi);
+    }
+
+    let mut out: Vec<Facet> = Vec::with_capacity(groups.len());
+    for g in &groups {
+        if g.len() > 1 {
+            let normal = planes[g[0]].as_ref().map_or(DVec3::ZERO, |p| p.normal);
+            if let Some(f) = merge_group(g, &facets, verts, normal) {
+                out.push(f);
+                continue;
+            }
+        }
+        out.extend(g.iter().map(|&fi| facets[fi].clone()));
+    }
+    for (i, f) in out.iter_mut().enumerate() {
+        f.marker = i32::try_from(i + 1).unwrap_or(i32::MAX);
+    }
+    plc.facets = out;
+}
+
+/// The plane of a mergeable facet: three exactly non-collinear vertices and a float normal.
+struct Plane {
+    a: DVec3,
+    b: DVec3,
+    c: DVec3,
+    normal: DVec3,
+}
+
+impl Plane {
+    /// `None` unless the facet is a single planar, non-degenerate polygon without holes whose
+    /// indices are all valid and distinct between neighbours.
+    fn of(f: &Facet, verts: &[DVec3]) -> Option<Plane> {
+        if f.polygons.len() != 1 || !f.hole_points.is_empty() || !f.hole_polygons.is_empty() {
+            return None;
+        }
+        let p = &f.polygons[0];
+        if p.len() < 3 || p.iter().any(|&v| v as usize >= verts.len()) {
+            return None;
+        }
+        if (0..p.len()).any(|i| p[i] == p[(i + 1) % p.len()]) {
+            return None;
+        }
+        let pts: Vec<DVec3> = p.iter().map(|&v| verts[v as usize]).collect();
+        let a = pts[0];
+        let b = *pts.iter().find(|&&q| q != a)?;
+        let c = *pts.iter().find(|&&q| !collinear(a, b, q))?;
+        let plane = Plane {
+            a,
+            b,
+            c,
+            normal: newell(&pts),
+        };
+        if plane.normal == DVec3::ZERO || !pts.iter().all(|&q| plane.contains(q)) {
+            return None;
+        }
+        Some(plane)
+    }
+
+    fn contains(&self, q: DVec3) -> bool {
+        orient3d(self.a, self.b, self.c, q) == 0.0
+    }
+}
+
+/// Exact collinearity: a, b, c are collinear iff the plane through them (if any) holds four
+/// affinely independent points, i.e. orient3d vanishes for every one of them.
+fn collinear(a: DVec3, b: DVec3, c: DVec3) -> bool {
+    [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z]
+        .iter()
+        .all(|&d| orient3d(a, b, c, d) == 0.0)
+}
+
+/// Newell's polygon normal (twice the vector area), in floating point.
+fn newell(pts: &[DVec3]) -> DVec3 {
+    let mut n = DVec3::ZERO;
+    for i in 0..pts.len() {
+        let (p, q) = (pts[i], pts[(i + 1) % pts.len()]);
+        n += DVec3::new(
+            (p.y - q.y) * (p.z + q.z),
+            (p.z - q.z) * (p.x + q.x),
+            (p.x - q.x) * (p.y + q.y),
+        );
+    }
+    n
+}
+
+/// The merged facet of a group, or `None` when its boundary is not a set of simple loops with
+/// exactly one outer loop.
+fn merge_group(group: &[usize], facets: &[Facet], verts: &[DVec3], normal: DVec3) -> Option<Facet> {
+    let directed = || {
+        group.iter().flat_map(|&fi| {
+            let p = &facets[fi].polygons[0];
+            (0..p.len()).map(move |i| (p[i], p[(i + 1) % p.len()]))
+        })
+    };
+    // Net count of each directed edge after cancelling opposite pairs.
+    let mut count: FxHashMap<(u32, u32), i64> = FxHashMap::default();
+    for (u, v) in directed() {
+        match count.get_mut(&(v, u)) {
+            Some(c) if *c > 0 => *c -= 1,
+            _ => *count.entry((u, v)).or_insert(0) += 1,
+        }
+    }
+    let mut boundary: Vec<(u32, u32)> = Vec::new();
+    for (u, v) in directed() {
+        if let Some(c) = count.get_mut(&(u, v)) {
+            if *c > 0 {
+                *c -= 1;
+                boundary.push((u, v));
+            }
+        }
+    }
+    let mut next: FxHashMap<u32, u32> = FxHashMap::default();
+    for &(u, v) in &boundary {
+        if next.insert(u, v).is_some() {
+            return None; // two outgoing boundary edges: patches touch at a vertex
+        }
+    }
+    let mut used: FxHashMap<u32, bool> = FxHashMap::default();
+    let mut outer: Option<Vec<u32>> = None;
+    let mut holes = Vec::new();
+    for &(start, _) in &boundary {
+        if used.contains_key(&start) {
+            continue;
+        }
+        let mut lp = vec![start];
+        used.insert(start, true);
+        let mut cur = *next.get(&start)?;
+        while cur != start {
+            if used.insert(cur, true).is_some() || lp.len() > boundary.len() {
+                return None;
+            }
+            lp.push(cur);
+            cur = *next.get(&cur)?;
+        }
+        if lp.len() < 3 {
+            return None;
+        }
+        let pts: Vec<DVec3> = lp.iter().map(|&v| verts[v as usize]).collect();
+        if newell(&pts).dot(normal) > 0.0 {
+            if outer.is_some() {
+                return None;
+            }
+            outer = Some(lp);
+        } else {
+            holes.push(lp);
+        }
+    }
+    Some(Facet {
+        polygons: vec![outer?],
+        hole_points: Vec::new(),
+        hole_polygons: holes,
+        marker: 0,
+    })
+}
+
+struct UnionFind {
+    parent: Vec<usize>,
+}
+
+impl UnionFind {
+    fn new(n: usize) -> Self {
+        UnionFind {
+            parent: (0..n).collect(),
+        }
+    }
+
+    fn find(&mut self, mut x: usize) -> usize {
+        while self.parent[x] != x {
+            self.parent[x] = self.parent[self.parent[x]];
+            x = self.parent[x];
+        }
+        x
+    }
+
+    fn union(&mut self, a: usize, b: usize) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        if ra != rb {
+            // Keep the smaller index as root so groups are keyed by their first facet.
+            let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
+            self.parent[hi] = lo;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tri(a: u32, b: u32, c: u32) -> Facet {
+        Facet {
+            polygons: vec![vec![a, b, c]],
+            marker: 9,
+            ..Facet::default()
+        }
+    }
+
+    /// A 3x3 grid of unit squares in z = 0, each split into two CCW triangles.
+    fn grid(skip_centre: bool) -> PlcInput {
+        let mut plc = PlcInput::default();
+        for j in 0..4 {
+            for i in 0..4 {
+                plc.vertices.push(DVec3::new(i as f64, j as f64, 0.0));
+            }
+        }
+        for j in 0..3u32 {
+            for i in 0..3u32 {
+                if skip_centre && i == 1 && j == 1 {
+                    continue;
+                }
+                let v = j * 4 + i;
+                plc.facets.push(tri(v, v + 1, v + 5));
+                plc.facets.push(tri(v, v + 5, v + 4));
+            }
+        }
+        plc
+    }
+
+    #[test]
+    fn flat_grid_becomes_one_polygon_with_collinear_vertices_kept() {
+        let mut plc = grid(false);
+        merge_coplanar_facets(&mut plc);
+        assert_eq!(plc.facets.len(), 1);
+        let f = &plc.facets[0];
+        assert_eq!(f.polygons[0].len(), 12);
+        assert!(f.hole_polygons.is_empty());
+        assert_eq!(f.marker, 1);
+        let pts: Vec<DVec3> = f.polygons[0]
+            .iter()
+            .map(|&v| plc.vertices[v as usize])
+            .collect();
+        assert!((newell(&pts).z - 18.0).abs() < 1e-12, "area 9, CCW");
+    }
+
+    #[test]
+    fn ring_gets_a_hole_polygon() {
+        let mut plc = grid(true);
+        merge_coplanar_facets(&mut plc);
+        assert_eq!(plc.facets.len(), 1);
+        let f = &plc.facets[0];
+        assert_eq!(f.polygons[0].len(), 12);
+        assert_eq!(f.hole_polygons.len(), 1);
+        let mut hole = f.hole_polygons[0].clone();
+        hole.sort_unstable();
+        assert_eq!(hole, vec![5, 6, 9, 10]);
+    }
+
+    #[test]
+    fn bent_or_flipped_neighbours_are_not_merged() {
+        let mut plc = PlcInput {
+            vertices: vec![
+                DVec3::new(0.0, 0.0, 0.0),
+                DVec3::new(1.0, 0.0, 0.0),
+                DVec3::new(0.0, 1.0, 0.0),
+                DVec3::new(1.0, -1.0, 1e-300),
+                DVec3::new(0.5, 0.5, 0.0),
+            ],
+            facets: vec![tri(0, 1, 2), tri(1, 0, 3)],
+            ..PlcInput::default()
+        };
+        merge_coplanar_facets(&mut plc);
+        assert_eq!(plc.facets.len(), 2, "1e-300 off the plane is not coplanar");
+        assert_eq!(plc.facets[1].marker, 2);
+        // Same edge direction (inconsistent orientation): not merged.
+        plc.vertices[3].z = 0.0;
+        plc.facets = vec![tri(0, 1, 2), tri(0, 1, 3)];
+        merge_coplanar_facets(&mut plc);
+        assert_eq!(plc.facets.len(), 2);
+        // Degenerate (collinear) facet is never merged.
+        plc.facets = vec![tri(0, 1, 2), tri(1, 0, 4), tri(0, 1, 3)];
+        plc.vertices[4] = DVec3::new(2.0, 0.0, 0.0);
+        merge_coplanar_facets(&mut plc);
+        assert_eq!(plc.facets.len(), 3);
+    }
+
+    #[test]
+    fn patch_touching_itself_at_a_vertex_is_left_alone() {
+        // The grid without its centre and its first corner square: the hole and the notch
+        // touch at vertex 5, which then has two outgoing boundary edges.
+        let mut plc = grid(true);
+        plc.facets.drain(0..2);
+        assert_eq!(plc.facets.len(), 14);
+        merge_coplanar_facets(&mut plc);
+        assert_eq!(plc.facets.len(), 14);
+        assert_eq!(plc.facets[13].marker, 14);
+    }
+
+    #[test]
+    fn bad_indices_do_not_panic() {
+        let mut plc = PlcInput {
+            vertices: vec![DVec3::ZERO, DVec3::X, DVec3::Y],
+            facets: vec![tri(0, 1, 7), tri(0, 0, 1), Facet::default()],
+            ..PlcInput::default()
+        };
+        merge_coplanar_facets(&mut plc);
+        assert_eq!(plc.facets.len(), 3);
+    }
+}

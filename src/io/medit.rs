@@ -1,0 +1,286 @@
+//! Medit / INRIA `.mesh` (ASCII) reader and writer for tetrahedral meshes.
+//!
+//! Written: `MeshVersionFormatted 2` (double precision), `Dimension 3`, `Vertices` (reference
+//! 0), `Tetrahedra` with the region attribute as reference, `Triangles` (the boundary) with the
+//! facet marker as reference, `End`. Indices are 1-based; empty element sections are omitted.
+//!
+//! Read: the same keywords (case-insensitive, free format: tokens may be split across lines,
+//! `#` comments), `MeshVersionFormatted` 1, 2 or 3, `Dimension 3` only. `Vertices`,
+//! `Tetrahedra` (reference -> `tet_regions`) and `Triangles` (-> `boundary`, reference ->
+//! `boundary_markers`) are kept; `Edges`, `Quadrilaterals`, `Hexahedra`, `Prisms`, `Pyramids`,
+//! `Corners`, `Ridges`, `Required*`, `Normals`, `NormalAtVertices`, `Tangents`,
+//! `TangentAtVertices` and `Identifier`/`Geometry` are read past; any other section is an
+//! error. Tetrahedra are kept as written: the reader does not reorient them. Binary `.meshb`
+//! is not supported.
+
+use super::text::{
+    check_index, check_mesh, check_mesh_io, create, err_at, read_text, to_u32, with_path,
+    write_err, Tokens, F,
+};
+use super::IoError;
+use crate::mesh::TetMesh;
+use std::io::Write;
+use std::path::Path;
+
+/// Writes `mesh` as a medit `.mesh` file.
+pub fn write_medit(path: &Path, mesh: &TetMesh) -> Result<(), IoError> {
+    check_mesh(mesh, &[]).map_err(|e| with_path(e, path))?;
+    let mut w = create(path)?;
+    format_medit(&mut w, mesh)
+        .and_then(|_| w.flush())
+        .map_err(|e| write_err(path, e))
+}
+
+/// Writes `mesh` in medit format to any writer.
+/// An inconsistent mesh is an `InvalidInput` error.
+pub fn format_medit<W: Write>(w: &mut W, mesh: &TetMesh) -> std::io::Result<()> {
+    check_mesh_io(mesh, &[])?;
+    writeln!(w, "MeshVersionFormatted 2\n\nDimension 3\n")?;
+    writeln!(w, "Vertices\n{}", mesh.vertices.len())?;
+    for p in &mesh.vertices {
+        writeln!(w, "{} {} {} 0", F(p.x), F(p.y), F(p.z))?;
+    }
+    if !mesh.tets.is_empty() {
+        writeln!(w, "\nTetrahedra\n{}", mesh.tets.len())?;
+        for (t, r) in mesh.tets.iter().zip(&mesh.tet_regions) {
+            writeln!(w, "{} {} {} {} {r}", t[0] + 1, t[1] + 1, t[2] + 1, t[3] + 1)?;
+        }
+    }
+    if !mesh.boundary.is_empty() {
+        writeln!(w, "\nTriangles\n{}", mesh.boundary.len())?;
+        for (t, m) in mesh.boundary.iter().zip(&mesh.boundary_markers) {
+            writeln!(w, "{} {} {} {m}", t[0] + 1, t[1] + 1, t[2] + 1)?;
+        }
+    }
+    writeln!(w, "\nEnd")
+}
+
+/// Reads a medit `.mesh` file.
+pub fn read_medit(path: &Path) -> Result<TetMesh, IoError> {
+    let text = read_text(path)?;
+    parse_medit(&text).map_err(|e| with_path(e, path))
+}
+
+/// Tokens per entry of the sections that are read past.
+fn skipped_section_width(kw: &str) -> Option<usize> {
+    const TABLE: &[(&str, usize)] = &[
+        ("edges", 3),
+        ("quadrilaterals", 5),
+        ("hexahedra", 9),
+        ("prisms", 7),
+        ("pyramids", 6),
+        ("corners", 1),
+        ("ridges", 1),
+        ("requiredvertices", 1),
+        ("requirededges", 1),
+        ("requiredtriangles", 1),
+        ("requiredquadrilaterals", 1),
+        ("requiredtetrahedra", 1),
+        ("normals", 3),
+        ("normalatvertices", 2),
+        ("tangents", 3),
+        ("tangentatvertices", 2),
+    ];
+    let kw = kw.to_ascii_lowercase();
+    TABLE.iter().find(|(k, _)| *k == kw).map(|&(_, n)| n)
+}
+
+/// Parses the text of a medit `.mesh` file.
+pub fn parse_medit(text: &str) -> Result<TetMesh, IoError> {
+    let mut tok = Tokens::new(text);
+    let mut mesh = TetMesh::default();
+    let mut seen_version = false;
+    // Element indices with their lines, checked once the vertex count is known.
+    let mut pending: Vec<(usize, i64, &'static str)> = Vec::new();
+    let mut tets: Vec<[i64; 4]> = Vec::new();
+    let mut tris: Vec<[i64; 3]> = Vec::new();
+    let mut seen_vertices = false;
+    while let Some((line, kw)) = tok.next_opt() {
+        let lower = kw.to_ascii_lowercase();
+        match lower.as_str() {
+            "meshversionformatted" => {
+                let (l, w) = tok.next("mesh version")?;
+                if !matches!(w, "1" | "2" | "3") {
+                    return Err(err_at(
+                        l,
+                        format!("unsupported MeshVersionFormatted '{w}' (1, 2 or 3)"),
+                    ));
+                }
+                seen_version = true;
+            }
+            "dimension" => {
+                let (l, w) = tok.next("dimension")?;
+                if w != "3" {
+                    return Err(err_at(l, format!("dimension must be 3, found '{w}'")));
+                }
+            }
+            "vertices" => {
+                if seen_vertices {
+                    return Err(err_at(line, "second Vertices section"));
+                }
+                seen_vertices = true;
+                let n = tok.usize("number of vertices")?;
+                to_u32(n, line, "number of vertices")?;
+                mesh.vertices.reserve(super::text::cap(n));
+                for _ in 0..n {
+                    mesh.vertices.push(tok.point()?);
+                    tok.i32("vertex reference")?;
+                }
+            }
+            "tetrahedra" => {
+                let n = tok.usize("number of tetrahedra")?;
+                for _ in 0..n {
+                    let mut t = [0i64; 4];
+                    for c in t.iter_mut() {
+                        let (l, v) = tok.raw_index("tetrahedron vertex index")?;
+                        pending.push((l, v, "tetrahedron vertex index"));
+                        *c = v;
+                    }
+                    tets.push(t);
+                    mesh.tet_regions.push(tok.i32("tetrahedron reference")?);
+                }
+            }
+            "triangles" => {
+                let n = tok.usize("number of triangles")?;
+                for _ in 0..n {
+                    let mut t = [0i64; 3];
+                    for c in t.iter_mut() {
+                        let (l, v) = tok.raw_index("triangle vertex index")?;
+                        pending.push((l, v, "triangle vertex index"));
+                        *c = v;
+                    }
+                    tris.push(t);
+                    mesh.boundary_markers.push(tok.i32("triangle reference")?);
+                }
+            }
+            "identifier" | "geometry" => {
+                // A quoted string, possibly with spaces: skip to the end of its line.
+                tok.next("value")?;
+                tok.skip_line();
+            }
+            "end" => break,
+            other => match skipped_section_width(other) {
+                Some(width) => {
+                    let n = tok.usize(&format!("number of entries of {kw}"))?;
+                    for _ in 0..n.saturating_mul(width) {
+                        tok.next(&format!("entry of {kw}"))?;
+                    }
+                }
+                None if kw.parse::<f64>().is_ok() => {
+                    return Err(err_at(
+                        line,
+                        format!(
+                            "found number '{kw}' where a keyword was expected (is the count of \
+                             the previous section wrong?)"
+                        ),
+                    ))
+                }
+                None => {
+                    return Err(err_at(
+                        line,
+                        format!("unknown or unsupported keyword '{kw}'"),
+                    ))
+                }
+            },
+        }
+    }
+    if !seen_version {
+        return Err(err_at(1, "missing 'MeshVersionFormatted' header"));
+    }
+    let nv = mesh.vertices.len();
+    for &(l, v, what) in &pending {
+        check_index(v, l, 1, nv, what)?;
+    }
+    // All indices are in 1..=nv <= u32::MAX + 1 now, so the conversions below are exact.
+    let id = |v: i64| (v - 1) as u32;
+    mesh.tets = tets
+        .iter()
+        .map(|t| [id(t[0]), id(t[1]), id(t[2]), id(t[3])])
+        .collect();
+    mesh.boundary = tris
+        .iter()
+        .map(|t| [id(t[0]), id(t[1]), id(t[2])])
+        .collect();
+    Ok(mesh)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SMALL: &str = "MeshVersionFormatted 2\nDimension\n3\nVertices\n4\n0 0 0 1\n1 0 0 1\n\
+        0 1 0 1\n0 0 1 1\nEdges\n1\n1 2 0\nTetrahedra\n1\n1 2 3 4 7\nTriangles\n1\n1 3 2 5\nEnd\n";
+
+    #[test]
+    fn reads_sections_and_skips_edges() {
+        let m = parse_medit(SMALL).unwrap();
+        assert_eq!(m.vertices.len(), 4);
+        assert_eq!(m.tets, vec![[0, 1, 2, 3]]);
+        assert_eq!(m.tet_regions, vec![7]);
+        assert_eq!(m.boundary, vec![[0, 2, 1]]);
+        assert_eq!(m.boundary_markers, vec![5]);
+    }
+
+    fn expect_err(text: &str, line: usize, needle: &str) {
+        let e = parse_medit(text).unwrap_err();
+        assert_eq!(e.line, Some(line), "{e}");
+        assert!(e.message.contains(needle), "'{needle}' not in: {e}");
+    }
+
+    #[test]
+    fn malformed_medit_files() {
+        expect_err("Dimension 3\n", 1, "missing 'MeshVersionFormatted'");
+        expect_err(
+            "MeshVersionFormatted 2\nDimension 2\n",
+            2,
+            "dimension must be 3",
+        );
+        expect_err(
+            "MeshVersionFormatted 9\n",
+            1,
+            "unsupported MeshVersionFormatted",
+        );
+        expect_err(
+            "MeshVersionFormatted 2\nVertices\n2\n0 0 0 0\n",
+            5,
+            "unexpected end",
+        );
+        expect_err(
+            "MeshVersionFormatted 2\nVertices\n1\n0 0 x 0\n",
+            4,
+            "bad number 'x'",
+        );
+        expect_err(
+            "MeshVersionFormatted 2\nVertices\n1\n0 0 0 0\nTetrahedra\n1\n1 1 1 2 0\n",
+            7,
+            "out of range",
+        );
+        expect_err(
+            "MeshVersionFormatted 2\nVertices\n1\n0 0 0 0\nTriangles\n1\n1 0 1 0\n",
+            7,
+            "out of range",
+        );
+        expect_err(
+            "MeshVersionFormatted 2\nBlobs\n1\n",
+            2,
+            "unknown or unsupported keyword",
+        );
+        expect_err(
+            "MeshVersionFormatted 2\nVertices\n-1\n",
+            3,
+            "bad non-negative integer",
+        );
+        expect_err(
+            "MeshVersionFormatted 2\nVertices\n1\n0 0 0 0\n1 1 1 0\n",
+            5,
+            "found number '1' where a keyword was expected",
+        );
+    }
+
+    #[test]
+    fn truncated_medit_never_panics() {
+        for cut in 0..SMALL.len() {
+            let _ = parse_medit(&SMALL[..cut]);
+        }
+    }
+}

@@ -1,0 +1,248 @@
+//! The state shared by boundary recovery and quality refinement: the Delaunay triangulation,
+//! the subsegments and each facet's 2D triangulation (its subfacets), and what every vertex
+//! lies on.
+
+use super::facet_mesh::{Change, FacetMesh};
+use super::MeshError;
+use crate::delaunay::{Delaunay, Inserted};
+use crate::plc::PlcInput;
+use glam::DVec3;
+use rustc_hash::{FxHashMap, FxHashSet};
+
+/// Where a vertex lies; decides which boundary structures a split must update.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VertexKind {
+    /// An input vertex.
+    Input,
+    /// Inserted on input segment `seg`.
+    Segment(u32),
+    /// Inserted inside input facet `facet`.
+    Facet(u32),
+    /// Inserted in the interior of the domain.
+    Volume,
+}
+
+/// An input segment: an edge of at least one facet polygon.
+#[derive(Debug, Clone)]
+pub struct Segment {
+    pub ends: [u32; 2],
+    /// Facets whose polygons use this segment.
+    pub facets: Vec<u32>,
+}
+
+pub struct Domain {
+    pub dt: Delaunay,
+    pub n_input: usize,
+    pub kind: Vec<VertexKind>,
+    pub segments: Vec<Segment>,
+    /// Current subsegments (sorted endpoint pair) -> input segment.
+    pub subsegs: FxHashMap<(u32, u32), u32>,
+    pub facets: Vec<FacetMesh>,
+    pub markers: Vec<i32>,
+    /// Current subfacets (sorted vertex triple) -> input facet.
+    pub subfacets: FxHashMap<[u32; 3], u32>,
+    /// Input vertices where two segments meet at an acute angle (split by concentric shells).
+    pub acute_vertices: FxHashSet<u32>,
+    /// Subsegments and subfacets to check for encroachment (see `recover::settle`).
+    pub dirty_segs: Vec<(u32, u32)>,
+    pub dirty_tris: Vec<[u32; 3]>,
+    /// Tets created by insertions since the refiner last looked (it classifies them).
+    pub created_log: Vec<u32>,
+}
+
+pub fn seg_key(a: u32, b: u32) -> (u32, u32) {
+    (a.min(b), a.max(b))
+}
+
+pub fn tri_key(t: [u32; 3]) -> [u32; 3] {
+    let mut k = t;
+    k.sort_unstable();
+    k
+}
+
+impl Domain {
+    /// Triangulates the input vertices and sets up segments and facet triangulations.
+    pub fn new(input: &PlcInput) -> Result<Domain, MeshError> {
+        let (mut dt, stats) = Delaunay::from_points(&input.vertices)
+            .map_err(|e| MeshError::InvalidInput(e.to_string()))?;
+        if stats.duplicates > 0 {
+            return Err(MeshError::InvalidInput(format!(
+                "{} duplicate vertices",
+                stats.duplicates
+            )));
+        }
+        dt.enable_tags();
+        let mut segments: Vec<Segment> = vec![];
+        let mut seg_index: FxHashMap<(u32, u32), u32> = FxHashMap::default();
+        let mut facets = Vec::with_capacity(input.facets.len());
+        let mut markers = vec![];
+        let mut subfacets = FxHashMap::default();
+        for (fi, f) in input.facets.iter().enumerate() {
+            let loops = f.polygons.iter().chain(f.hole_polygons.iter());
+            for poly in loops {
+                for k in 0..poly.len() {
+                    let key = seg_key(poly[k], poly[(k + 1) % poly.len()]);
+                    let s = *seg_index.entry(key).or_insert_with(|| {
+                        segments.push(Segment {
+                            ends: [key.0, key.1],
+                            facets: vec![],
+                        });
+                        (segments.len() - 1) as u32
+                    });
+                    let facets_of = &mut segments[s as usize].facets;
+                    if !facets_of.contains(&(fi as u32)) {
+                        facets_of.push(fi as u32);
+                    }
+                }
+            }
+            let fm = FacetMesh::new(
+                &input.vertices,
+                &f.polygons,
+                &f.hole_polygons,
+                &f.hole_points,
+            )
+            .map_err(|e| MeshError::InvalidInput(format!("facet {fi}: {e}")))?;
+            for t in fm.triangles() {
+                subfacets.insert(tri_key(t), fi as u32);
+            }
+            facets.push(fm);
+            markers.push(f.marker);
+        }
+        let acute_vertices = acute_segment_vertices(&input.vertices, &segments);
+        Ok(Domain {
+            dt,
+            n_input: input.vertices.len(),
+            kind: vec![VertexKind::Input; input.vertices.len()],
+            subsegs: seg_index,
+            segments,
+            facets,
+            markers,
+            subfacets,
+            acute_vertices,
+            dirty_segs: vec![],
+            dirty_tris: vec![],
+            created_log: vec![],
+        })
+    }
+
+    pub fn point(&self, v: u32) -> DVec3 {
+        self.dt.point(v)
+    }
+
+    /// Inserts a new vertex into the 3D triangulation.
+    pub fn insert_point(
+        &mut self,
+        p: DVec3,
+        kind: VertexKind,
+        hint: Option<u32>,
+    ) -> Result<u32, MeshError> {
+        match self.dt.insert(p, hint) {
+            Ok(Inserted::New(id)) => {
+                self.kind.push(kind);
+                self.queue_around_last_insertion();
+                self.created_log.extend_from_slice(self.dt.last_created());
+                Ok(id)
+            }
+            Ok(Inserted::Duplicate(v)) => Err(MeshError::Internal(format!(
+                "split point ({}, {}, {}) coincides with vertex {v}",
+                p.x, p.y, p.z
+            ))),
+            Err(e) => Err(MeshError::Internal(e.to_string())),
+        }
+    }
+
+    fn apply_change(&mut self, facet: u32, change: &Change) {
+        for t in &change.removed {
+            self.subfacets.remove(&tri_key(*t));
+        }
+        for t in &change.added {
+            self.subfacets.insert(tri_key(*t), facet);
+            self.dirty_tris.push(tri_key(*t));
+        }
+    }
+
+    /// Where to split subsegment ab: its midpoint, or, next to an acute input vertex, the
+    /// point at a power-of-two distance from it closest to the midpoint (concentric shells,
+    /// Shewchuk 2002) so that splits around the apex stop encroaching each other.
+    pub fn segment_split_point(&self, a: u32, b: u32) -> DVec3 {
+        let (pa, pb) = (self.point(a), self.point(b));
+        let apex = match (
+            self.acute_vertices.contains(&a),
+            self.acute_vertices.contains(&b),
+        ) {
+            (true, false) => Some((pa, pb)),
+            (false, true) => Some((pb, pa)),
+            _ => None,
+        };
+        let Some((o, q)) = apex else {
+            return pa + (pb - pa) * 0.5;
+        };
+        let len = o.distance(q);
+        let shell = 2f64.powf((len * 0.5).log2().round());
+        let t = (shell / len).clamp(0.25, 0.75);
+        o + (q - o) * t
+    }
+
+    /// Splits subsegment ab at `p`: inserts the vertex and updates subsegments and every facet
+    /// holding the segment. Returns the new vertex.
+    pub fn split_subsegment(&mut self, a: u32, b: u32, p: DVec3) -> Result<u32, MeshError> {
+        let key = seg_key(a, b);
+        let seg = *self
+            .subsegs
+            .get(&key)
+            .ok_or_else(|| MeshError::Internal(format!("({a}, {b}) is not a subsegment")))?;
+        let hint = self.dt.vertex_tet(a);
+        let id = self.insert_point(p, VertexKind::Segment(seg), hint)?;
+        self.subsegs.remove(&key);
+        for half in [seg_key(a, id), seg_key(id, b)] {
+            self.subsegs.insert(half, seg);
+            self.dirty_segs.push(half);
+        }
+        for f in self.segments[seg as usize].facets.clone() {
+            let change = self.facets[f as usize]
+                .split_edge(a, b, id, p)
+                .map_err(|e| MeshError::Internal(format!("facet {f}: {e}")))?;
+            self.apply_change(f, &change);
+        }
+        Ok(id)
+    }
+
+    /// Inserts `p` (inside facet `f`) into the 3D triangulation and the facet's triangulation.
+    pub fn split_in_facet(
+        &mut self,
+        f: u32,
+        p: DVec3,
+        hint: Option<u32>,
+    ) -> Result<u32, MeshError> {
+        let id = self.insert_point(p, VertexKind::Facet(f), hint)?;
+        let change = self.facets[f as usize]
+            .insert(id, p)
+            .map_err(|_| MeshError::Internal(format!("facet {f}: split point left the facet")))?;
+        self.apply_change(f, &change);
+        Ok(id)
+    }
+}
+
+/// Input vertices where two segments meet at less than 90 degrees.
+fn acute_segment_vertices(points: &[DVec3], segments: &[Segment]) -> FxHashSet<u32> {
+    let mut around: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
+    for s in segments {
+        around.entry(s.ends[0]).or_default().push(s.ends[1]);
+        around.entry(s.ends[1]).or_default().push(s.ends[0]);
+    }
+    let mut acute = FxHashSet::default();
+    for (&v, others) in &around {
+        let o = points[v as usize];
+        'pairs: for i in 0..others.len() {
+            for j in i + 1..others.len() {
+                let d1 = points[others[i] as usize] - o;
+                let d2 = points[others[j] as usize] - o;
+                if d1.dot(d2) > 1e-12 * d1.length() * d2.length() {
+                    acute.insert(v);
+                    break 'pairs;
+                }
+            }
+        }
+    }
+    acute
+}

@@ -1,0 +1,474 @@
+//! "Clean Bad Elements" (the paper's REMOVE-SLIVER main loop): size-bad tets (R / f(c) > B)
+//! first, then radius-edge-bad (rho > rho0), then slivers (sigma < sigma0). A bad tet is
+//! refined from a random point of its picking ball (c, delta R) chosen, among `max_tries`
+//! draws, to create no small sliver (a new sliver with circumradius <= b R); when its
+//! circumcentre encroaches a subsegment or subfacet, that boundary element is split from its
+//! own picking interval or disk instead.
+
+use super::domain::{seg_key, tri_key, Domain};
+use super::mark::Regions;
+use super::{MeshError, Params, Spacing};
+use crate::delaunay::{tables::FACE, DryRun, INFINITE};
+use crate::geom::{diametric_ball, equatorial_ball, tri_circumcenter, TetQuality};
+use glam::DVec3;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+/// Badness classes, in refinement priority order.
+const SIZE: u8 = 2;
+const RATIO: u8 = 1;
+const SLIVER: u8 = 0;
+
+#[derive(Debug, Clone, Copy)]
+struct Bad {
+    class: u8,
+    badness: f64,
+    tet: u32,
+    verts: [u32; 4],
+}
+impl PartialEq for Bad {
+    fn eq(&self, o: &Self) -> bool {
+        self.cmp(o) == Ordering::Equal
+    }
+}
+impl Eq for Bad {}
+impl PartialOrd for Bad {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for Bad {
+    fn cmp(&self, o: &Self) -> Ordering {
+        self.class
+            .cmp(&o.class)
+            .then(self.badness.total_cmp(&o.badness))
+            .then(o.verts.cmp(&self.verts))
+    }
+}
+
+/// A boundary element a point would encroach.
+#[derive(Debug, Clone, Copy)]
+enum Boundary {
+    Segment(u32, u32),
+    Facet(u32, [u32; 3]),
+}
+
+pub struct Refiner<'a> {
+    pub dom: &'a mut Domain,
+    pub params: &'a Params,
+    pub spacing: &'a dyn Spacing,
+    pub regions: &'a Regions,
+    rng: ChaCha8Rng,
+    heap: BinaryHeap<Bad>,
+    /// Bad tets left alone because fixing them needed an ever smaller boundary split (the
+    /// signature of an acute input angle).
+    pub gave_up: usize,
+    pub stop_reason: Option<String>,
+}
+
+impl<'a> Refiner<'a> {
+    pub fn new(
+        dom: &'a mut Domain,
+        params: &'a Params,
+        spacing: &'a dyn Spacing,
+        regions: &'a Regions,
+    ) -> Self {
+        Refiner {
+            rng: ChaCha8Rng::seed_from_u64(params.seed),
+            dom,
+            params,
+            spacing,
+            regions,
+            heap: BinaryHeap::new(),
+            gave_up: 0,
+            stop_reason: None,
+        }
+    }
+
+    /// Spacing at `p` for a tet of region tag `tag`: the user's f, capped by the region's
+    /// maximum size; a value that is not finite and positive is an error.
+    pub fn spacing_at(&self, p: DVec3, tag: u32) -> Result<f64, MeshError> {
+        let mut f = self.spacing.at(p);
+        if !(f.is_finite() && f > 0.0) {
+            return Err(MeshError::BadSpacing { point: p, value: f });
+        }
+        if let Some(m) = self.regions.max_size.get(tag as usize).copied().flatten() {
+            f = f.min(m);
+        }
+        Ok(f)
+    }
+
+    fn classify(&self, t: u32) -> Result<Option<Bad>, MeshError> {
+        let tag = self.dom.dt.tag(t);
+        if tag == 0 || !self.dom.dt.is_finite(t) {
+            return Ok(None);
+        }
+        let [a, b, c, d] = self.dom.dt.tet_points(t);
+        let q = TetQuality::of(a, b, c, d);
+        let verts = self.dom.dt.tet(t);
+        let Some(centre) = q.circumcenter else {
+            return Ok(Some(Bad {
+                class: SLIVER,
+                badness: f64::INFINITY,
+                tet: t,
+                verts,
+            }));
+        };
+        let f = self.spacing_at(centre, tag)?;
+        let xi = q.circumradius / f;
+        let p = self.params;
+        let bad = |class, badness| {
+            Some(Bad {
+                class,
+                badness,
+                tet: t,
+                verts,
+            })
+        };
+        Ok(if xi > p.size_factor {
+            bad(SIZE, xi)
+        } else if q.rho > p.rho0 {
+            bad(RATIO, q.rho)
+        } else if q.sigma < p.sigma0 || q.min_dihedral < p.min_dihedral {
+            bad(SLIVER, 1.0 / q.min_dihedral.max(1e-300))
+        } else {
+            None
+        })
+    }
+
+    /// Queues the bad tets among those created since the last call.
+    fn push_recent(&mut self) -> Result<(), MeshError> {
+        let recent = std::mem::take(&mut self.dom.created_log);
+        self.push_tets(&recent)
+    }
+
+    fn push_tets(&mut self, tets: &[u32]) -> Result<(), MeshError> {
+        for &t in tets {
+            if let Some(b) = self.classify(t)? {
+                self.heap.push(b);
+            }
+        }
+        Ok(())
+    }
+
+    /// Runs the refinement until no bad tet is left or a budget stops it.
+    pub fn run(&mut self, progress: &mut dyn FnMut(usize) -> bool) -> Result<(), MeshError> {
+        let all: Vec<u32> = self.dom.dt.finite_tet_ids().collect();
+        self.push_tets(&all)?;
+        let mut steps = 0usize;
+        while let Some(bad) = self.heap.pop() {
+            if !self.dom.dt.is_alive(bad.tet) || self.dom.dt.tet(bad.tet) != bad.verts {
+                continue;
+            }
+            if self.dom.dt.num_vertices() >= self.params.max_vertices {
+                self.stop_reason = Some(format!(
+                    "vertex budget max_vertices = {} reached",
+                    self.params.max_vertices
+                ));
+                return Ok(());
+            }
+            steps += 1;
+            if steps % 1024 == 0 && !progress(self.dom.dt.num_vertices()) {
+                return Err(MeshError::Cancelled);
+            }
+            if std::env::var("SM_DEBUG").is_ok() && bad.class == SLIVER {
+                eprintln!("sliver pop tet {} badness {}", bad.tet, bad.badness);
+            }
+            let gave_up = self.gave_up;
+            self.refine_tet(bad)?;
+            // A boundary split need not destroy the tet that asked for it: look again.
+            if self.gave_up == gave_up
+                && self.dom.dt.is_alive(bad.tet)
+                && self.dom.dt.tet(bad.tet) == bad.verts
+            {
+                self.push_tets(&[bad.tet])?;
+            }
+        }
+        if std::env::var("SM_DEBUG").is_ok() {
+            let mut counts = [0; 3];
+            let ids: Vec<u32> = self.dom.dt.finite_tet_ids().collect();
+            for t in ids {
+                if let Some(b) = self.classify(t)? {
+                    counts[b.class as usize] += 1;
+                    let q = {
+                        let [a, b2, c, d] = self.dom.dt.tet_points(t);
+                        TetQuality::of(a, b2, c, d)
+                    };
+                    eprintln!(
+                        "left: tet {t} {:?} class {} rho {} sigma {} tag {}",
+                        b.verts,
+                        b.class,
+                        q.rho,
+                        q.sigma,
+                        self.dom.dt.tag(t)
+                    );
+                }
+            }
+            eprintln!("steps {steps} remaining bad by class {counts:?}");
+        }
+        Ok(())
+    }
+
+    fn refine_tet(&mut self, bad: Bad) -> Result<(), MeshError> {
+        let [a, b, c, d] = self.dom.dt.tet_points(bad.tet);
+        let q = TetQuality::of(a, b, c, d);
+        let Some(centre) = q.circumcenter else {
+            self.gave_up += 1;
+            return Ok(());
+        };
+        let r = q.circumradius;
+        if let Some(bnd) = self.encroached_boundary(centre, Some(bad.tet)) {
+            let rb = self.boundary_radius(bnd);
+            if bad.class != SIZE && rb < 0.25 * r {
+                self.gave_up += 1;
+                return Ok(());
+            }
+            return self.split_boundary(bnd, r);
+        }
+        // Draw candidates from the picking ball; keep the one with fewest small slivers.
+        let mut best: Option<(usize, f64, DVec3)> = None;
+        for _ in 0..self.params.max_tries.max(1) {
+            let p = centre + self.random_in_ball() * (self.params.delta * r);
+            let Some((n_small, worst)) = self.small_slivers(p, r, Some(bad.tet), None) else {
+                continue; // p would break the boundary
+            };
+            if best.is_none_or(|(n, w, _)| (n_small, -worst) < (n, -w)) {
+                best = Some((n_small, worst, p));
+            }
+            if n_small == 0 {
+                break;
+            }
+        }
+        let p = match best {
+            Some((_, _, p)) => p,
+            None => centre,
+        };
+        if self.encroached_boundary(p, Some(bad.tet)).is_some() {
+            // Every draw would break the boundary and so does the centre (only near it).
+            if let Some(bnd) = self.encroached_boundary(centre, Some(bad.tet)) {
+                return self.split_boundary(bnd, r);
+            }
+            self.gave_up += 1;
+            return Ok(());
+        }
+        self.dom
+            .insert_point(p, super::domain::VertexKind::Volume, Some(bad.tet))?;
+        self.settle_boundary()?;
+        self.push_recent()
+    }
+
+    fn random_in_ball(&mut self) -> DVec3 {
+        loop {
+            let v = DVec3::new(
+                self.rng.gen_range(-1.0..1.0),
+                self.rng.gen_range(-1.0..1.0),
+                self.rng.gen_range(-1.0..1.0),
+            );
+            if v.length_squared() <= 1.0 {
+                return v;
+            }
+        }
+    }
+
+    /// Small slivers (circumradius <= b R, sigma < sigma0) inserting `p` would create, and the
+    /// smallest sigma among them; None if inserting `p` would cross the boundary (unless the
+    /// boundary element is `allowed`, the one being split).
+    fn small_slivers(
+        &mut self,
+        p: DVec3,
+        r: f64,
+        hint: Option<u32>,
+        allowed: Option<Boundary>,
+    ) -> Option<(usize, f64)> {
+        if allowed.is_none() && self.encroached_boundary(p, hint).is_some() {
+            return None;
+        }
+        let DryRun::Cavity { faces, .. } = self.dom.dt.dry_run(p, hint) else {
+            return None;
+        };
+        let mut n = 0;
+        let mut worst = f64::INFINITY;
+        for f in faces {
+            if f.contains(&INFINITE) {
+                continue;
+            }
+            let [x, y, z] = f.map(|v| self.dom.point(v));
+            let q = TetQuality::of(x, y, z, p);
+            let sliver = q.sigma < self.params.sigma0 || q.min_dihedral < self.params.min_dihedral;
+            if q.circumradius <= self.params.b * r && sliver {
+                n += 1;
+                worst = worst.min(q.min_dihedral);
+            }
+        }
+        Some((n, worst))
+    }
+
+    /// The boundary element whose protection inserting `p` would violate: a subsegment or
+    /// subfacet among the cavity's edges/faces with `p` in its closed diametric/equatorial
+    /// ball, or, when the cavity would cross the boundary (it holds an outside tet or would
+    /// delete a subfacet), the subfacet it crosses.
+    fn encroached_boundary(&mut self, p: DVec3, hint: Option<u32>) -> Option<Boundary> {
+        let DryRun::Cavity { removed, .. } = self.dom.dt.dry_run(p, hint) else {
+            return None;
+        };
+        let dom = &*self.dom;
+        let mut crosses = false;
+        let mut crossed: Option<Boundary> = None;
+        let mut segs = vec![];
+        let mut facets = vec![];
+        for &t in &removed {
+            if !dom.dt.is_finite(t) || dom.dt.tag(t) == 0 {
+                crosses = true;
+                continue;
+            }
+            let v = dom.dt.tet(t);
+            for i in 0..4 {
+                for j in i + 1..4 {
+                    let k = seg_key(v[i], v[j]);
+                    if dom.subsegs.contains_key(&k) {
+                        segs.push(k);
+                    }
+                }
+                let f = FACE[i].map(|l| v[l]);
+                if let Some(&fi) = dom.subfacets.get(&tri_key(f)) {
+                    facets.push((fi, tri_key(f)));
+                    let n = dom.dt.neighbors(t)[i];
+                    if removed.contains(&n) {
+                        crosses = true;
+                        crossed = Some(Boundary::Facet(fi, tri_key(f)));
+                    }
+                }
+            }
+        }
+        segs.sort_unstable();
+        segs.dedup();
+        for &(a, b) in &segs {
+            let (c, r) = diametric_ball(dom.point(a), dom.point(b));
+            if p.distance_squared(c) <= r * r {
+                return Some(Boundary::Segment(a, b));
+            }
+        }
+        facets.sort_unstable();
+        facets.dedup();
+        for &(fi, t) in &facets {
+            let [x, y, z] = t.map(|v| dom.point(v));
+            if let Some((c, r)) = equatorial_ball(x, y, z) {
+                if p.distance_squared(c) <= r * r {
+                    return Some(Boundary::Facet(fi, t));
+                }
+            }
+        }
+        if crosses {
+            return crossed.or_else(|| facets.first().map(|&(fi, t)| Boundary::Facet(fi, t)));
+        }
+        None
+    }
+
+    fn boundary_radius(&self, b: Boundary) -> f64 {
+        match b {
+            Boundary::Segment(a, b) => 0.5 * self.dom.point(a).distance(self.dom.point(b)),
+            Boundary::Facet(_, t) => {
+                let [x, y, z] = t.map(|v| self.dom.point(v));
+                equatorial_ball(x, y, z).map_or(0.0, |(_, r)| r)
+            }
+        }
+    }
+
+    /// Splits a boundary element from its picking region, then restores empty encroachment
+    /// around the new vertex.
+    fn split_boundary(&mut self, b: Boundary, _r_tau: f64) -> Result<(), MeshError> {
+        match b {
+            Boundary::Segment(a, c) => self.split_segment_picked(a, c)?,
+            Boundary::Facet(f, t) => {
+                let [x, y, z] = t.map(|v| self.dom.point(v));
+                let Some(cf) = tri_circumcenter(x, y, z) else {
+                    self.gave_up += 1;
+                    return Ok(());
+                };
+                let cf = self.dom.snap_to_facet_plane(f, cf);
+                let enc = self.dom.facet_subsegments_encroached_by(f, cf);
+                if let Some(&(a, c)) = enc.first() {
+                    self.split_segment_picked(a, c)?;
+                } else if self.dom.facets[f as usize].locate(cf).is_none() {
+                    self.gave_up += 1;
+                    return Ok(());
+                } else {
+                    let rf = cf.distance(x);
+                    let n = (y - x).cross(z - x).normalize();
+                    let u = (y - x).normalize();
+                    let w = n.cross(u);
+                    let mut best: Option<(usize, f64, DVec3)> = None;
+                    for _ in 0..self.params.max_tries.max(1) {
+                        let (s, th) = (
+                            self.rng.gen::<f64>().sqrt(),
+                            self.rng.gen::<f64>() * std::f64::consts::TAU,
+                        );
+                        let p = cf + (u * th.cos() + w * th.sin()) * (s * self.params.delta * rf);
+                        let p = self.dom.snap_to_facet_plane(f, p);
+                        if self.dom.facets[f as usize].locate(p).is_none()
+                            || !self.dom.facet_subsegments_encroached_by(f, p).is_empty()
+                        {
+                            continue;
+                        }
+                        let hint = self.dom.dt.vertex_tet(t[0]);
+                        let Some((n_small, worst)) = self.small_slivers(p, rf, hint, Some(b))
+                        else {
+                            continue;
+                        };
+                        if best.is_none_or(|(n, w, _)| (n_small, -worst) < (n, -w)) {
+                            best = Some((n_small, worst, p));
+                        }
+                        if n_small == 0 {
+                            break;
+                        }
+                    }
+                    let p = best.map_or(cf, |(_, _, p)| p);
+                    let hint = self.dom.dt.vertex_tet(t[0]);
+                    self.dom.split_in_facet(f, p, hint)?;
+                }
+            }
+        }
+        self.settle_boundary()?;
+        self.push_recent()
+    }
+
+    /// Splits subsegment ac from its picking interval (midpoint +- delta/2 of its length), or at
+    /// the concentric-shell point next to an acute input vertex.
+    fn split_segment_picked(&mut self, a: u32, c: u32) -> Result<(), MeshError> {
+        let (pa, pc) = (self.dom.point(a), self.dom.point(c));
+        let shell = self.dom.acute_vertices.contains(&a) != self.dom.acute_vertices.contains(&c);
+        let p = if shell {
+            self.dom.segment_split_point(a, c)
+        } else {
+            let r = 0.5 * pa.distance(pc);
+            let mut best: Option<(usize, f64, DVec3)> = None;
+            for _ in 0..self.params.max_tries.max(1) {
+                let t = 0.5 + self.rng.gen_range(-0.5..0.5) * self.params.delta;
+                let p = pa + (pc - pa) * t;
+                let hint = self.dom.dt.vertex_tet(a);
+                let Some((n_small, worst)) =
+                    self.small_slivers(p, r, hint, Some(Boundary::Segment(a, c)))
+                else {
+                    continue;
+                };
+                if best.is_none_or(|(n, w, _)| (n_small, -worst) < (n, -w)) {
+                    best = Some((n_small, worst, p));
+                }
+                if n_small == 0 {
+                    break;
+                }
+            }
+            best.map_or(pa + (pc - pa) * 0.5, |(_, _, p)| p)
+        };
+        self.dom.split_subsegment(a, c, p)?;
+        Ok(())
+    }
+
+    /// After a boundary split, restores empty encroachment around it.
+    fn settle_boundary(&mut self) -> Result<(), MeshError> {
+        let mut budget = super::recover::MAX_RECOVERY_SPLITS;
+        self.dom.settle(&mut budget)
+    }
+}

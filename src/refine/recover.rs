@@ -1,0 +1,251 @@
+//! "Enforce Empty Encroachment" (the paper's first step, Shewchuk's conforming Delaunay
+//! boundary recovery): split subsegments whose diametric ball holds a vertex or that are not
+//! Delaunay edges, then subfacets whose equatorial ball holds a vertex or that are not Delaunay
+//! faces; a subfacet split yields to the split of a subsegment its centre encroaches.
+//! When it returns, every subsegment is an edge and every subfacet a face of the
+//! triangulation (checked exactly, combinatorially), so the boundary is conforming.
+
+use super::domain::{seg_key, tri_key, Domain};
+use super::MeshError;
+use crate::delaunay::{tables::FACE, INFINITE};
+use crate::geom::{diametric_ball, equatorial_ball, tri_circumcenter};
+use glam::DVec3;
+
+/// Safety net against a non-terminating recovery (e.g. an input angle so small that even
+/// concentric shells cannot help within floating point): the number of splits allowed.
+pub const MAX_RECOVERY_SPLITS: usize = 2_000_000;
+
+/// Why a boundary element is not conforming yet.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Status {
+    Ok,
+    Missing,
+    Encroached,
+}
+
+impl Domain {
+    /// Splits until every subsegment and subfacet is present and unencroached.
+    pub fn recover_boundary(&mut self, budget: &mut usize) -> Result<(), MeshError> {
+        let mut segs: Vec<(u32, u32)> = self.subsegs.keys().copied().collect();
+        segs.sort_unstable(); // deterministic order
+        let mut tris: Vec<[u32; 3]> = self.subfacets.keys().copied().collect();
+        tris.sort_unstable();
+        self.dirty_segs.extend(segs);
+        self.dirty_tris.extend(tris);
+        self.settle(budget)
+    }
+
+    /// Queues the subsegments and subfacets among the edges and faces of the tets the last
+    /// insertion created: the new vertex may encroach them.
+    pub fn queue_around_last_insertion(&mut self) {
+        for &t in self.dt.last_created() {
+            let v = self.dt.tet(t);
+            for i in 0..4 {
+                for j in i + 1..4 {
+                    let k = seg_key(v[i], v[j]);
+                    if self.subsegs.contains_key(&k) {
+                        self.dirty_segs.push(k);
+                    }
+                }
+                let f = FACE[i].map(|l| v[l]);
+                if !f.contains(&INFINITE) && self.subfacets.contains_key(&tri_key(f)) {
+                    self.dirty_tris.push(tri_key(f));
+                }
+            }
+        }
+    }
+
+    /// Works through the queued subsegments (first) and subfacets until none is missing or
+    /// encroached; every split queues what it creates or may encroach.
+    pub fn settle(&mut self, budget: &mut usize) -> Result<(), MeshError> {
+        loop {
+            if let Some((a, b)) = self.dirty_segs.pop() {
+                if !self.subsegs.contains_key(&(a, b)) || self.subsegment_status(a, b) == Status::Ok
+                {
+                    continue;
+                }
+                spend(budget)?;
+                let p = self.segment_split_point(a, b);
+                self.split_subsegment(a, b, p)?;
+                continue;
+            }
+            let Some(tri) = self.dirty_tris.pop() else {
+                return Ok(());
+            };
+            let Some(&f) = self.subfacets.get(&tri) else {
+                continue;
+            };
+            match self.subfacet_status(tri) {
+                Status::Ok => {}
+                Status::Missing if self.flip_to_match(f, tri) => {}
+                _ => self.split_subfacet(f, tri, budget)?,
+            }
+        }
+    }
+
+    /// Whether subsegment ab is an unencroached edge of the triangulation.
+    pub fn segment_ok(&self, a: u32, b: u32) -> bool {
+        self.subsegment_status(a, b) == Status::Ok
+    }
+
+    /// A subsegment is fine when it is an edge of the triangulation and no vertex of a tet
+    /// around it lies strictly inside its diametric ball (for a Delaunay edge, a vertex in the
+    /// ball implies one among the edge's link).
+    fn subsegment_status(&self, a: u32, b: u32) -> Status {
+        let Some(_) = self.dt.find_edge(a, b) else {
+            return Status::Missing;
+        };
+        let (c, r) = diametric_ball(self.point(a), self.point(b));
+        let r2 = r * r;
+        for t in self.dt.vertex_star(a) {
+            let v = self.dt.tet(t);
+            if !v.contains(&b) {
+                continue;
+            }
+            for &w in &v {
+                if w != a && w != b && w != INFINITE && self.point(w).distance_squared(c) < r2 {
+                    return Status::Encroached;
+                }
+            }
+        }
+        Status::Ok
+    }
+
+    /// A subfacet is fine when it is a face of the triangulation and neither apex of its two
+    /// tets lies strictly inside its equatorial ball.
+    fn subfacet_status(&self, t: [u32; 3]) -> Status {
+        let Some(sides) = self.dt.find_face(t[0], t[1], t[2]) else {
+            return Status::Missing;
+        };
+        let Some((c, r)) = equatorial_ball(self.point(t[0]), self.point(t[1]), self.point(t[2]))
+        else {
+            return Status::Missing;
+        };
+        for (tet, i) in sides {
+            let apex = self.dt.tet(tet)[i];
+            if apex != INFINITE && self.point(apex).distance_squared(c) < r * r {
+                return Status::Encroached;
+            }
+        }
+        Status::Ok
+    }
+
+    /// A subfacet can be missing only because the 3D triangulation broke a cocircular tie the
+    /// other way: if flipping one of its unconstrained edges in the facet yields two faces the
+    /// 3D triangulation has, take that flip instead of inserting a point.
+    fn flip_to_match(&mut self, f: u32, tri: [u32; 3]) -> bool {
+        for k in 0..3 {
+            let (x, y, z) = (tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]);
+            let fm = &self.facets[f as usize];
+            if fm.is_constrained(x, y) {
+                continue;
+            }
+            let Some(d) = fm
+                .opposite(x, y)
+                .into_iter()
+                .flatten()
+                .flatten()
+                .find(|&d| d != z)
+            else {
+                continue;
+            };
+            if self.dt.find_face(z, x, d).is_none() || self.dt.find_face(z, d, y).is_none() {
+                continue;
+            }
+            if self.facets[f as usize].flip(x, y) {
+                self.subfacets.remove(&tri_key([x, y, z]));
+                self.subfacets.remove(&tri_key([x, y, d]));
+                for t in [tri_key([z, x, d]), tri_key([z, d, y])] {
+                    self.subfacets.insert(t, f);
+                    self.dirty_tris.push(t);
+                }
+                return true;
+            }
+        }
+        false
+    }
+
+    /// Splits subfacet `tri` of facet `f` at its circumcentre, or, when that centre lies
+    /// outside the facet or encroaches one of the facet's subsegments, splits those
+    /// subsegments instead.
+    fn split_subfacet(
+        &mut self,
+        f: u32,
+        tri: [u32; 3],
+        budget: &mut usize,
+    ) -> Result<(), MeshError> {
+        let [a, b, c] = tri.map(|v| self.point(v));
+        let Some(centre) = tri_circumcenter(a, b, c) else {
+            return Err(MeshError::Internal(format!(
+                "facet {f}: flat subfacet {tri:?}"
+            )));
+        };
+        let centre = self.snap_to_facet_plane(f, centre);
+        let encroached = self.facet_subsegments_encroached_by(f, centre);
+        if !encroached.is_empty() {
+            for (x, y) in encroached {
+                if self.subsegs.contains_key(&(x, y)) {
+                    spend(budget)?;
+                    let p = self.segment_split_point(x, y);
+                    self.split_subsegment(x, y, p)?;
+                }
+            }
+            return Ok(());
+        }
+        if self.facets[f as usize].locate(centre).is_none() {
+            // Outside the facet yet encroaching none of its subsegments: only possible through
+            // rounding; split the longest edge of the subfacet's own subsegments, else insert
+            // the centroid.
+            let centroid = (a + b + c) / 3.0;
+            spend(budget)?;
+            let hint = self.dt.vertex_tet(tri[0]);
+            self.split_in_facet(f, centroid, hint)?;
+            return Ok(());
+        }
+        spend(budget)?;
+        let hint = self.dt.vertex_tet(tri[0]);
+        self.split_in_facet(f, centre, hint)?;
+        Ok(())
+    }
+
+    /// Subsegments of facet `f` whose closed diametric ball contains `p`.
+    pub fn facet_subsegments_encroached_by(&self, f: u32, p: DVec3) -> Vec<(u32, u32)> {
+        let mut out = vec![];
+        for [x, y] in self.facets[f as usize].constrained_edges() {
+            let (c, r) = diametric_ball(self.point(x), self.point(y));
+            if p.distance_squared(c) <= r * r {
+                out.push(seg_key(x, y));
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
+    /// For an axis-aligned facet, puts the coordinate along its normal back exactly on the
+    /// plane (the circumcentre formula rounds it); other facets keep the computed point.
+    pub fn snap_to_facet_plane(&self, f: u32, p: DVec3) -> DVec3 {
+        let verts: Vec<u32> = self.facets[f as usize].vertices().collect();
+        let Some(&v0) = verts.first() else {
+            return p;
+        };
+        let q0 = self.point(v0);
+        let mut p = p;
+        for axis in 0..3 {
+            if verts.iter().all(|&v| self.point(v)[axis] == q0[axis]) {
+                p[axis] = q0[axis];
+            }
+        }
+        p
+    }
+}
+
+pub fn spend(budget: &mut usize) -> Result<(), MeshError> {
+    if *budget == 0 {
+        return Err(MeshError::Internal(
+            "boundary recovery did not terminate within its split budget".into(),
+        ));
+    }
+    *budget -= 1;
+    Ok(())
+}

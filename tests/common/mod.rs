@@ -1,0 +1,152 @@
+//! Helpers shared by the integration tests: model paths and mesh invariant checkers.
+#![allow(dead_code)]
+
+use slivermesh::geom::{insphere, orient3d};
+use slivermesh::mesh::TetMesh;
+use slivermesh::plc::PlcInput;
+use slivermesh::DVec3;
+use std::collections::HashMap;
+use std::path::PathBuf;
+
+pub fn models_dir() -> PathBuf {
+    let here = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/models");
+    if here.exists() {
+        here
+    } else {
+        PathBuf::from("/work/shared/models")
+    }
+}
+
+pub fn read_model(rel: &str) -> PlcInput {
+    let opts = slivermesh::io::ReadOptions {
+        merge_coplanar: rel.ends_with(".off"),
+    };
+    slivermesh::io::read_plc(&models_dir().join(rel), &opts)
+        .unwrap_or_else(|e| panic!("reading {rel}: {e}"))
+}
+
+pub fn tet_volume(m: &TetMesh, t: [u32; 4]) -> f64 {
+    let p = t.map(|v| m.vertices[v as usize]);
+    orient3d(p[0], p[1], p[2], p[3]) / 6.0
+}
+
+/// Every tet positively oriented.
+pub fn check_orientation(m: &TetMesh) {
+    for (i, &t) in m.tets.iter().enumerate() {
+        assert!(
+            tet_volume(m, t) > 0.0,
+            "tet {i} {t:?} is not positively oriented"
+        );
+    }
+}
+
+/// Faces shared by two tets: the opposite vertex lies outside (or on) the circumsphere
+/// (local Delaunay over every interior face implies the tets are Delaunay).
+pub fn check_delaunay(m: &TetMesh) {
+    let mut faces: HashMap<[u32; 3], Vec<(usize, u32)>> = HashMap::new();
+    for (i, t) in m.tets.iter().enumerate() {
+        for k in 0..4 {
+            let mut f = [t[(k + 1) % 4], t[(k + 2) % 4], t[(k + 3) % 4]];
+            f.sort_unstable();
+            faces.entry(f).or_default().push((i, t[k]));
+        }
+    }
+    for (f, owners) in &faces {
+        assert!(
+            owners.len() <= 2,
+            "face {f:?} shared by {} tets",
+            owners.len()
+        );
+        if owners.len() == 2 {
+            let (t, _) = owners[0];
+            let (_, apex) = owners[1];
+            let p = m.tets[t].map(|v| m.vertices[v as usize]);
+            let s = insphere(p[0], p[1], p[2], p[3], m.vertices[apex as usize]);
+            assert!(
+                s <= 0.0,
+                "face {f:?}: vertex {apex} inside the circumsphere of tet {t}"
+            );
+        }
+    }
+}
+
+pub fn triangle_area(m: &TetMesh, t: [u32; 3]) -> f64 {
+    let [a, b, c] = t.map(|v| m.vertices[v as usize]);
+    0.5 * (b - a).cross(c - a).length()
+}
+
+/// Area of a planar polygon (3D vertex loop), by the vector area.
+pub fn polygon_area(pts: &[DVec3]) -> f64 {
+    let mut s = DVec3::ZERO;
+    for k in 0..pts.len() {
+        s += pts[k].cross(pts[(k + 1) % pts.len()]);
+    }
+    0.5 * s.length()
+}
+
+/// Area of each input facet bounding the domain (as the validator measures it: holes
+/// removed), summed per marker.
+pub fn facet_area_by_marker(input: &PlcInput) -> HashMap<i32, f64> {
+    let plc = slivermesh::plc::validate(input).expect("valid input");
+    let mut out: HashMap<i32, f64> = HashMap::new();
+    for f in &plc.facets {
+        // A facet with no domain on either side (e.g. between a hole and the outside) is not
+        // part of the meshed boundary.
+        let bounds_domain = f.triangle_cells.iter().flatten().any(|&c| {
+            matches!(
+                plc.cells[c as usize].kind,
+                slivermesh::plc::CellKind::Domain { .. }
+            )
+        });
+        if bounds_domain {
+            *out.entry(f.marker).or_default() += f.area;
+        }
+    }
+    out
+}
+
+pub fn boundary_area_by_marker(m: &TetMesh) -> HashMap<i32, f64> {
+    let mut out: HashMap<i32, f64> = HashMap::new();
+    for (t, &mk) in m.boundary.iter().zip(&m.boundary_markers) {
+        *out.entry(mk).or_default() += triangle_area(m, *t);
+    }
+    out
+}
+
+pub fn total_volume(m: &TetMesh) -> f64 {
+    m.tets.iter().map(|&t| tet_volume(m, t)).sum()
+}
+
+pub fn region_volume(m: &TetMesh, region: i32) -> f64 {
+    m.tets
+        .iter()
+        .zip(&m.tet_regions)
+        .filter(|(_, &r)| r == region)
+        .map(|(&t, _)| tet_volume(m, t))
+        .sum()
+}
+
+/// The surface is closed: each boundary edge of an external facet is shared by an even
+/// number of boundary triangles, and every boundary triangle is a face of a tet.
+pub fn check_boundary_faces_are_tet_faces(m: &TetMesh) {
+    let mut faces = std::collections::HashSet::new();
+    for t in &m.tets {
+        for k in 0..4 {
+            let mut f = [t[(k + 1) % 4], t[(k + 2) % 4], t[(k + 3) % 4]];
+            f.sort_unstable();
+            faces.insert(f);
+        }
+    }
+    for b in &m.boundary {
+        let mut f = *b;
+        f.sort_unstable();
+        assert!(
+            faces.contains(&f),
+            "boundary triangle {b:?} is not a tet face"
+        );
+    }
+}
+
+pub fn rel_close(a: f64, b: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol * b.abs().max(1e-300)
+}
