@@ -1,8 +1,8 @@
 /* The C ABI on real meshes (waits on refine::mesh: exits 77 = skipped while sm_refine reports
  * "not implemented yet"): the unit cube meshes with volume 1, positive tets, boundary area 6 and
  * the facet markers; outputs copy only when the buffer is large enough; the quality report
- * matches; .vtu writing; region attributes; a non-planar facet is SM_ERR_INVALID_INPUT; cancel
- * in the middle of a run. */
+ * matches; .vtu writing; region attributes; a non-planar facet is SM_ERR_INVALID_INPUT; spacing
+ * values of 0 or NaN met only during refinement; cancel in the middle of a run. */
 #include "common.h"
 
 static int g_pending = 0;
@@ -12,6 +12,19 @@ static double spacing_graded(double x, double y, double z, void *user_data) {
     (void)z;
     (void)user_data;
     return 0.12 + 0.15 * x; /* finer at x = 0 */
+}
+
+/* Fine everywhere at the corners, NaN in the middle slab: only refinement sees the NaN. */
+static double spacing_nan_inside(double x, double y, double z, void *user_data) {
+    (void)y;
+    (void)z;
+    (void)user_data;
+    return (x > 0.3 && x < 0.7) ? NAN : 0.2;
+}
+
+static double spacing_zero_inside(double x, double y, double z, void *user_data) {
+    (void)user_data;
+    return (x > 0.2 && x < 0.8 && y > 0.2 && y < 0.8 && z > 0.2 && z < 0.8) ? 0.0 : 0.2;
 }
 
 static int32_t progress_count(double fraction, size_t n_vertices, void *user_data) {
@@ -184,6 +197,31 @@ static void test_non_planar_facet(void) {
         CHECK_STATUS(m, s, SM_ERR_INVALID_INPUT);
         CHECK_ERROR_HAS(m, "facet 1");
         CHECK(sm_num_tets(m) == 0);
+        printf("non-planar: %s\n", sm_last_error(m));
+    }
+    sm_destroy(m);
+}
+
+/* Bad values away from the input vertices reach refinement, which fails naming the point. */
+static void test_bad_spacing_inside(void) {
+    sm_mesher *m = make_cube();
+    sm_status s;
+    CHECK_STATUS(m, sm_set_spacing_cb(m, spacing_nan_inside, NULL), SM_OK);
+    s = sm_refine(m);
+    if (mesh_pending(m, s)) {
+        g_pending = 1;
+    } else {
+        CHECK_STATUS(m, s, SM_ERR_SPACING);
+        CHECK_ERROR_HAS(m, "returned NaN at (0.");
+        CHECK(sm_num_tets(m) == 0);
+        printf("NaN inside: %s\n", sm_last_error(m));
+    }
+    CHECK_STATUS(m, sm_set_spacing_cb(m, spacing_zero_inside, NULL), SM_OK);
+    s = sm_refine(m);
+    if (!mesh_pending(m, s)) {
+        CHECK_STATUS(m, s, SM_ERR_SPACING);
+        CHECK_ERROR_HAS(m, "returned 0 at (0.");
+        printf("0 inside: %s\n", sm_last_error(m));
     }
     sm_destroy(m);
 }
@@ -209,6 +247,7 @@ int main(void) {
     test_cube();
     test_boundary_only();
     test_non_planar_facet();
+    test_bad_spacing_inside();
     test_cancel_mid_run();
     if (g_failures == 0 && g_pending) {
         printf("test_mesh: skipped parts wait on refine::mesh\n");

@@ -26,12 +26,13 @@ static double spacing(double x, double y, double z, void *user_data) {
     return g->h_min + (g->h_max - g->h_min) * t;
 }
 
-/* Prints a line every 25 %; returning non-zero would cancel sm_refine. */
+/* Prints a line each time the vertex count doubles (the fraction is only an estimate: the share
+ * of the "max_vertices" budget used); returning non-zero would cancel sm_refine. */
 static int32_t progress(double fraction, size_t n_vertices, void *user_data) {
-    double *next = (double *)user_data;
-    if (fraction >= *next) {
-        printf("  %3.0f %%  %zu vertices\n", 100.0 * fraction, n_vertices);
-        *next += 0.25;
+    size_t *next = (size_t *)user_data;
+    if (n_vertices >= *next) {
+        printf("  %zu vertices (%.4f %% of the vertex budget)\n", n_vertices, 100.0 * fraction);
+        *next = 2 * n_vertices;
     }
     return 0;
 }
@@ -53,7 +54,7 @@ int main(int argc, char **argv) {
                                          {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
     const char *out = argc > 1 ? argv[1] : "cube_c.vtu";
     struct grading g = {0.08, 0.3};
-    double next_report = 0.0;
+    size_t next_report = 0;
     sm_quality q;
     const char *reason;
     int k;

@@ -37,11 +37,13 @@ contains
     integer(c_size_t), value :: n_vertices
     type(c_ptr), value :: user_data
     integer(c_int32_t) :: stop
-    integer, pointer :: next_percent
-    call c_f_pointer(user_data, next_percent)
-    if (100 * fraction >= next_percent) then
-      print '(2x, i3, a, i0, a)', next_percent, ' %  ', n_vertices, ' vertices'
-      next_percent = next_percent + 25
+    integer(c_size_t), pointer :: next_count
+    ! Report each time the vertex count doubles (fraction: share of the vertex budget used).
+    call c_f_pointer(user_data, next_count)
+    if (n_vertices >= next_count) then
+      print '(2x, i0, a, f8.4, a)', n_vertices, ' vertices (', 100 * fraction, &
+        ' % of the vertex budget)'
+      next_count = 2 * n_vertices
     end if
     stop = 0  ! non-zero would cancel sm_refine
   end function cube_progress
@@ -56,7 +58,7 @@ program cube
 
   type(c_ptr) :: m
   type(grading), target :: g
-  integer, target :: next_percent = 0
+  integer(c_size_t), target :: next_count = 0
   type(sm_quality) :: q
   real(c_double) :: xyz(3, 8)
   ! Vertex ids are 0-based (C convention).
@@ -84,7 +86,7 @@ program cube
   end do
   call check(sm_add_region(m, 0.5d0, 0.5d0, 0.5d0, 1_c_int32_t, 0d0), 'sm_add_region')
   call check(sm_set_spacing_cb(m, c_funloc(cube_spacing), c_loc(g)), 'sm_set_spacing_cb')
-  call check(sm_set_progress_cb(m, c_funloc(cube_progress), c_loc(next_percent)), &
+  call check(sm_set_progress_cb(m, c_funloc(cube_progress), c_loc(next_count)), &
              'sm_set_progress_cb')
   call check(sm_set_param(m, 'rho0', 2.0_c_double), 'sm_set_param')
   call check(sm_refine(m), 'sm_refine')
