@@ -4,6 +4,11 @@
 
 #include <stdio.h>
 
+#if SIZE_MAX == UINT64_MAX
+/* The Fortran module (include/slivermesh.f90) and the Rust tests check the same size. */
+typedef char sm_quality_is_168_bytes[sizeof(sm_quality) == 168 ? 1 : -1];
+#endif
+
 static double size_fn(double x, double y, double z, void *user_data) {
     (void)user_data;
     return 0.1 + 0.0 * (x + y + z);

@@ -1,7 +1,8 @@
 !> The Fortran module against the library: string wrappers, parameters, status texts, Fortran
 !> callbacks (a spacing returning 0, a batched spacing returning NaN, a progress callback that
-!> cancels), outputs before sm_refine with an omitted optional argument. Runs now; the cube
-!> meshing from Fortran is examples/fortran/cube.f90 (test ffi_example_fortran).
+!> cancels), outputs before sm_refine with an omitted optional argument, then a real mesh: the
+!> sm_quality layout matches C, buffer too small, optional markers omitted. The example
+!> examples/fortran/cube.f90 (test ffi_example_fortran) meshes and writes a .vtu.
 module test_callbacks
   use, intrinsic :: iso_c_binding, only: c_double, c_ptr, c_size_t, c_int32_t
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
@@ -42,7 +43,8 @@ program test_fortran
   real(c_double) :: v, xyz(3, 8)
   integer(c_int32_t), parameter :: faces(4, 6) = reshape([ &
     0, 2, 3, 1,  4, 5, 7, 6,  0, 1, 5, 4,  2, 6, 7, 3,  0, 4, 6, 2,  1, 3, 7, 5], [4, 6])
-  integer(c_int32_t) :: tets(4, 1)
+  integer(c_int32_t) :: tets(4, 1), status
+  integer(c_int32_t), allocatable :: tris(:, :)
   integer :: i, k, failures = 0
 
   call expect(len(sm_version()) >= 5, 'version')
@@ -85,6 +87,27 @@ program test_fortran
   call expect(sm_set_spacing_const(m, 0.3d0) == SM_OK, 'const spacing')
   call expect(sm_set_progress_cb(m, c_funloc(cancel), c_null_ptr) == SM_OK, 'progress cb')
   call expect(sm_refine(m) == SM_ERR_CANCELLED, 'cancel')
+
+  ! A real mesh: the struct layout matches C (size, and figures consistent with the counts).
+  call expect(c_sizeof(q) == 168_c_size_t, 'sizeof(sm_quality) == 168 as in C')
+  call expect(sm_set_progress_cb(m, c_null_funptr, c_null_ptr) == SM_OK, 'no progress cb')
+  status = sm_refine(m)
+  call expect(status == SM_OK, 'refine the cube')
+  if (status == SM_OK) then
+    call expect(sm_get_quality(m, q) == SM_OK, 'quality')
+    call expect(q%n_tets == sm_num_tets(m) .and. q%n_tets > 0, 'quality n_tets')
+    call expect(q%n_vertices == sm_num_vertices(m), 'quality n_vertices')
+    call expect(q%n_boundary_faces == sm_num_boundary_faces(m), 'quality n_boundary_faces')
+    call expect(q%min_dihedral_deg > 0 .and. q%min_dihedral_deg <= q%max_dihedral_deg, &
+                'dihedral range')
+    call expect(q%complete == 0 .or. q%complete == 1, 'complete flag')
+    allocate (tris(3, sm_num_boundary_faces(m)))
+    call expect(sm_get_boundary_faces(m, tris, capacity=size(tris, 2, c_size_t) - 1) &
+                == SM_ERR_BUFFER_TOO_SMALL, 'boundary buffer too small')
+    call expect(sm_get_boundary_faces(m, tris, capacity=size(tris, 2, c_size_t)) == SM_OK, &
+                'boundary faces, markers omitted')
+    call expect(minval(tris) >= 0 .and. maxval(tris) < sm_num_vertices(m), 'boundary ids')
+  end if
   call sm_destroy(m)
   call sm_destroy(c_null_ptr)
 

@@ -111,6 +111,8 @@ fn status_codes_are_fixed_and_described() {
     assert_eq!(text(sm_status_str(-1)), "unknown status");
     assert_eq!(text(sm_status_str(999)), "unknown status");
     assert_eq!(text(sm_version()), env!("CARGO_PKG_VERSION"));
+    // include/slivermesh.f90 mirrors sm_quality field by field and checks this size too.
+    assert_eq!(std::mem::size_of::<sm_quality>(), 168);
 }
 
 #[test]
