@@ -164,6 +164,9 @@ static void test_params(void) {
     CHECK_STATUS(m, sm_set_param(m, "sigma0", 0.03), SM_OK);
     CHECK_STATUS(m, sm_set_param(m, "delta", 0.2), SM_OK);
     CHECK_STATUS(m, sm_set_param(m, "b", 5), SM_OK);
+    CHECK_STATUS(m, sm_set_param(m, "min_dihedral", 12), SM_OK);
+    CHECK_STATUS(m, sm_get_param(m, "min_dihedral", &v), SM_OK);
+    CHECK(v == 12.0);
 
     CHECK_STATUS(m, sm_set_param(m, "rh0", 2), SM_ERR_INVALID_ARGUMENT);
     CHECK_ERROR_HAS(m, "\"rh0\"");
@@ -172,6 +175,9 @@ static void test_params(void) {
     CHECK_ERROR_HAS(m, "sqrt(6)/4");
     CHECK_STATUS(m, sm_set_param(m, "sigma0", 0.2), SM_ERR_INVALID_ARGUMENT);
     CHECK_STATUS(m, sm_set_param(m, "delta", 1.0), SM_ERR_INVALID_ARGUMENT);
+    CHECK_STATUS(m, sm_set_param(m, "delta", 0.0), SM_ERR_INVALID_ARGUMENT);
+    CHECK_STATUS(m, sm_set_param(m, "min_dihedral", 80), SM_ERR_INVALID_ARGUMENT);
+    CHECK_ERROR_HAS(m, "70.5");
     CHECK_STATUS(m, sm_set_param(m, "seed", 0.5), SM_ERR_INVALID_ARGUMENT);
     CHECK_ERROR_HAS(m, "whole");
     CHECK_STATUS(m, sm_set_param(m, "max_tries", 0), SM_ERR_INVALID_ARGUMENT);

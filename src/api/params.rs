@@ -2,7 +2,7 @@
 //! range checks that say why a value is refused.
 
 use super::error::{invalid, Error};
-use crate::geom::{REGULAR_RHO, REGULAR_SIGMA};
+use crate::geom::{REGULAR_DIHEDRAL, REGULAR_RHO, REGULAR_SIGMA};
 pub use crate::refine::Params;
 
 /// Every name [`set_param`] accepts, in documentation order (`"B"` is an alias of
@@ -10,6 +10,7 @@ pub use crate::refine::Params;
 pub const PARAM_NAMES: &[&str] = &[
     "rho0",
     "sigma0",
+    "min_dihedral",
     "delta",
     "b",
     "size_factor",
@@ -20,29 +21,47 @@ pub const PARAM_NAMES: &[&str] = &[
     "refine",
 ];
 
+/// Smallest accepted `rho0` (the refiner's own limit, `Params::check`).
+const MIN_RHO0: f64 = 0.7;
+
+/// Upper end (exclusive) of `min_dihedral`, degrees: just below the regular tetrahedron's 70.53.
+const MAX_MIN_DIHEDRAL: f64 = 70.5;
+
 /// Largest integer an `f64` holds exactly: integer parameters above it are refused rather than
 /// silently rounded.
 const MAX_EXACT_INT: f64 = 9_007_199_254_740_992.0; // 2^53
 
 /// Sets the parameter `name` to `value`, leaving `params` unchanged on error.
 ///
-/// Names are case-sensitive: `rho0` (> sqrt(6)/4, the regular tetrahedron's R/L), `sigma0`
-/// (in [0, 0.1179): 0 turns sliver removal off), `delta` (in [0, 1)), `b` (> 0),
-/// `size_factor` or `B` (> 0), `seed` (integer in [0, 2^53]), `max_vertices` (integer >= 4),
-/// `max_tries` (integer >= 1), `refine` (0 or 1). Integer parameters must be given as whole
-/// numbers.
+/// Names are case-sensitive: `rho0` (>= 0.7: no tetrahedron gets below sqrt(6)/4 = 0.612),
+/// `sigma0` (in [0, 0.1179): 0 turns the sigma test off), `min_dihedral` (degrees, in
+/// [0, 70.5): 0 turns the angle test off), `delta` (in (0, 1)), `b` (> 0), `size_factor` or `B`
+/// (> 0), `seed` (integer in [0, 2^53]), `max_vertices` (integer >= 4), `max_tries`
+/// (integer >= 1), `refine` (0 or 1). Integer parameters must be given as whole numbers.
+/// The result also passes `Params::check` (the refiner's own validation), so a value accepted
+/// here is never refused by `refine`.
 pub fn set_param(params: &mut Params, name: &str, value: f64) -> Result<(), Error> {
+    let mut candidate = params.clone();
+    set_unchecked(&mut candidate, name, value)?;
+    if let Err(e) = candidate.check() {
+        return invalid(e);
+    }
+    *params = candidate;
+    Ok(())
+}
+
+fn set_unchecked(params: &mut Params, name: &str, value: f64) -> Result<(), Error> {
     if value.is_nan() {
         return invalid(format!("parameter \"{name}\" is NaN"));
     }
     match name {
         "rho0" => {
             finite(name, value)?;
-            if value <= REGULAR_RHO {
+            if value < MIN_RHO0 {
                 return invalid(format!(
-                    "rho0 = {value} is unreachable: no tetrahedron has a radius-edge ratio below \
-                     sqrt(6)/4 = {REGULAR_RHO:.4} (the regular one); use rho0 > {REGULAR_RHO:.4} \
-                     (2 is the usual choice)"
+                    "rho0 = {value} is out of reach: no tetrahedron has a radius-edge ratio below \
+                     sqrt(6)/4 = {REGULAR_RHO:.4} (the regular one), and a bound that close cannot \
+                     be met on a whole mesh; use rho0 >= {MIN_RHO0} (2 is the usual choice)"
                 ));
             }
             params.rho0 = value;
@@ -57,12 +76,23 @@ pub fn set_param(params: &mut Params, name: &str, value: f64) -> Result<(), Erro
             }
             params.sigma0 = value;
         }
+        "min_dihedral" => {
+            finite(name, value)?;
+            if !(0.0..MAX_MIN_DIHEDRAL).contains(&value) {
+                return invalid(format!(
+                    "min_dihedral = {value} is out of range [0, {MAX_MIN_DIHEDRAL}) degrees: the \
+                     regular tetrahedron's dihedral angle is {REGULAR_DIHEDRAL:.2}, the largest \
+                     smallest angle a tet can have; 0 turns the angle test off"
+                ));
+            }
+            params.min_dihedral = value;
+        }
         "delta" => {
             finite(name, value)?;
-            if !(0.0..1.0).contains(&value) {
+            if !(value > 0.0 && value < 1.0) {
                 return invalid(format!(
-                    "delta = {value} is out of range [0, 1): the picking ball (c, delta*R) must \
-                     lie inside the circumsphere"
+                    "delta = {value} is out of range (0, 1): the picking ball (c, delta*R) must \
+                     lie inside the circumsphere and have room to pick from"
                 ));
             }
             params.delta = value;
@@ -101,6 +131,7 @@ pub fn get_param(params: &Params, name: &str) -> Result<f64, Error> {
     Ok(match name {
         "rho0" => params.rho0,
         "sigma0" => params.sigma0,
+        "min_dihedral" => params.min_dihedral,
         "delta" => params.delta,
         "b" => params.b,
         "size_factor" | "B" => params.size_factor,
@@ -165,6 +196,7 @@ mod tests {
         let values = [
             ("rho0", 1.5),
             ("sigma0", 0.05),
+            ("min_dihedral", 12.0),
             ("delta", 0.25),
             ("b", 3.0),
             ("size_factor", 1.5),
@@ -197,6 +229,10 @@ mod tests {
     #[test]
     fn out_of_range_values_give_a_reason() {
         assert!(err("rho0", 0.5).contains("sqrt(6)/4"));
+        assert!(err("rho0", 0.69).contains(">= 0.7"));
+        assert!(err("min_dihedral", 70.5).contains("regular"));
+        assert!(err("min_dihedral", -1.0).contains("out of range"));
+        assert!(err("delta", 0.0).contains("(0, 1)"));
         assert!(err("rho0", f64::INFINITY).contains("finite"));
         assert!(err("rho0", f64::NAN).contains("NaN"));
         assert!(err("sigma0", 0.2).contains("regular"));
@@ -213,10 +249,26 @@ mod tests {
     }
 
     #[test]
+    fn accepted_values_pass_the_refiners_check() {
+        for (name, v) in [
+            ("rho0", 0.7),
+            ("delta", 0.999),
+            ("sigma0", 0.1178),
+            ("B", 1e-6),
+        ] {
+            let mut p = Params::default();
+            set_param(&mut p, name, v).unwrap();
+            p.check().unwrap();
+        }
+    }
+
+    #[test]
     fn boundary_values_accepted() {
         let mut p = Params::default();
         set_param(&mut p, "sigma0", 0.0).unwrap();
-        set_param(&mut p, "delta", 0.0).unwrap();
+        set_param(&mut p, "min_dihedral", 0.0).unwrap();
+        set_param(&mut p, "rho0", 0.7).unwrap();
+        set_param(&mut p, "delta", 1e-9).unwrap();
         set_param(&mut p, "seed", 0.0).unwrap();
         set_param(&mut p, "seed", MAX_EXACT_INT).unwrap();
         assert_eq!(p.seed, 1 << 53);
