@@ -51,12 +51,12 @@ fn busy(function: &str) -> FfiError {
     )
 }
 
-/// Runs `f` on the state of the handle `m` and turns its outcome into a status: `SM_OK` (the last
+/// Runs `f` on the state of the handle `h` and turns its outcome into a status: `SM_OK` (the last
 /// error becomes ""), the error's status (its message, prefixed with `function`, becomes the last
 /// error), or `SM_ERR_PANIC` (the handle is poisoned). NULL gives `SM_ERR_NULL`, a poisoned handle
 /// `SM_ERR_POISONED`, a handle whose state is borrowed (re-entry from a callback) `SM_ERR_BUSY`.
 ///
-/// The exported function turns its `m` into `h` with `m.as_ref()` (NULL gives `None`), under its
+/// The exported function makes `h` from its `m` with `m.as_ref()` (NULL gives `None`), under its
 /// own contract that `m` is NULL or a live handle.
 pub(crate) fn handle_call(
     h: Option<&sm_mesher>,
@@ -96,7 +96,7 @@ pub(crate) fn handle_call(
     })
 }
 
-/// Runs the query `f` on the state of the handle `m`; `default` when `m` is NULL, poisoned or
+/// Runs the query `f` on the state of the handle `h`; `default` when `h` is NULL, poisoned or
 /// busy, or when `f` panics (which poisons the handle). Leaves the last error alone.
 ///
 /// As [`handle_call`], `h` comes from the exported function's `m.as_ref()`.
