@@ -1,35 +1,25 @@
-use slivermesh::geom::*;
 use slivermesh::io::*;
-use slivermesh::refine::*;
 fn main() {
-    let input = read_plc(
-        std::path::Path::new("../shared/models/poly/cube.poly"),
-        &ReadOptions::default(),
-    )
-    .unwrap();
-    let p = Params {
-        sigma0: 0.05,
-        ..Params::default()
-    };
-    let (m, _) = mesh(&input, &p, Some(&ConstantSpacing(0.1)), None).unwrap();
-    let mut worst = (180.0, 0);
-    for (i, t) in m.tets.iter().enumerate() {
-        let [a, b, c, d] = t.map(|v| m.vertices[v as usize]);
-        let q = TetQuality::of(a, b, c, d);
-        if q.min_dihedral < worst.0 {
-            worst = (q.min_dihedral, i);
+    let m = read_mesh(std::path::Path::new("/tmp/slivermesh-demo.vtu")).unwrap();
+    let mut e = vec![];
+    for t in &m.tets {
+        for i in 0..4 {
+            for j in i + 1..4 {
+                let (a, b) = (t[i], t[j]);
+                e.push((
+                    m.vertices[a as usize].distance(m.vertices[b as usize]),
+                    a.min(b),
+                    a.max(b),
+                ));
+            }
         }
     }
-    let t = m.tets[worst.1];
-    let [a, b, c, d] = t.map(|v| m.vertices[v as usize]);
-    let q = TetQuality::of(a, b, c, d);
-    println!(
-        "{:?}\n{:?}\nangles {:?}\nrho {} sigma {}",
-        t,
-        q,
-        dihedral_angles(a, b, c, d),
-        radius_edge_ratio(a, b, c, d),
-        sigma(a, b, c, d)
-    );
-    println!("{a} {b} {c} {d}");
+    e.sort_by(|x, y| x.0.total_cmp(&y.0));
+    e.dedup();
+    for x in &e[..6] {
+        println!(
+            "{:?} {} {}",
+            x, m.vertices[x.1 as usize], m.vertices[x.2 as usize]
+        );
+    }
 }

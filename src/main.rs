@@ -1,6 +1,7 @@
 //! The `slivermesh` command line.
 //!
-//! `slivermesh` with no arguments runs the built-in demo (`run_demo`); `slivermesh delaunay`
+//! `slivermesh` with no arguments runs the built-in demo (`cli::mesh::run_demo`);
+//! `slivermesh mesh` meshes a domain file; `slivermesh delaunay`
 //! triangulates a point file; `slivermesh gen-points` writes the seeded point sets the
 //! benchmarks and the CGAL comparison (ctests/) share.
 
@@ -39,6 +40,43 @@ enum Command {
         #[arg(long, value_name = "FILE")]
         stats_json: Option<PathBuf>,
     },
+    /// Mesh a domain (.poly, .smesh, .off, .stl) with quality refinement, or remove the slivers
+    /// of an existing mesh (.mesh). Output format by extension (.vtu, .mesh, .msh, .node/.ele).
+    Mesh {
+        /// Input domain or existing mesh.
+        input: PathBuf,
+        /// Write the mesh here.
+        #[arg(short, long, value_name = "OUTPUT")]
+        output: Option<PathBuf>,
+        /// Only recover the boundary (conforming Delaunay mesh, no quality refinement).
+        #[arg(long)]
+        no_refine: bool,
+        /// Constant spacing H (bounds every tet's circumradius); default: automatic, graded
+        /// from the input's local feature size.
+        #[arg(long, value_name = "H")]
+        size: Option<f64>,
+        /// Radius-edge bound rho0 (default 2).
+        #[arg(long, value_name = "R")]
+        rho: Option<f64>,
+        /// Sliver bound sigma0 = V / L^3 (default 0.02).
+        #[arg(long, value_name = "S")]
+        sigma: Option<f64>,
+        /// Smallest dihedral angle allowed, in degrees (default 15).
+        #[arg(long, value_name = "DEG")]
+        min_dihedral: Option<f64>,
+        /// Random seed (same input, parameters and seed: identical output).
+        #[arg(long, value_name = "N")]
+        seed: Option<u64>,
+        /// Stop refining at this many vertices (the report then says complete: false).
+        #[arg(long, value_name = "N")]
+        max_vertices: Option<usize>,
+        /// Keep .off/.stl triangles as separate facets instead of merging coplanar ones.
+        #[arg(long)]
+        no_merge: bool,
+        /// Write the report as JSON to this file.
+        #[arg(long, value_name = "FILE")]
+        stats_json: Option<PathBuf>,
+    },
     /// Write a seeded point set (the inputs of the benchmarks and the CGAL comparison).
     GenPoints {
         /// uniform (unit cube), grid (integer k^3 grid, k = round(cbrt(n))), sphere (unit
@@ -67,7 +105,32 @@ fn parse_kind(s: &str) -> Result<Kind, String> {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        None => run_demo(),
+        None => cli::mesh::run_demo(),
+        Some(Command::Mesh {
+            input,
+            output,
+            no_refine,
+            size,
+            rho,
+            sigma,
+            min_dihedral,
+            seed,
+            max_vertices,
+            no_merge,
+            stats_json,
+        }) => {
+            let opts = cli::mesh::MeshOptions {
+                no_refine,
+                size,
+                rho,
+                sigma,
+                min_dihedral,
+                seed,
+                max_vertices,
+                no_merge,
+            };
+            cli::mesh::run_mesh(&input, output.as_deref(), stats_json.as_deref(), &opts)
+        }
         Some(Command::Delaunay {
             points,
             output,
@@ -87,17 +150,6 @@ fn main() -> ExitCode {
             ExitCode::from(1)
         }
     }
-}
-
-/// The main job (`cargo run --release`): for now, triangulates 100,000 uniform random points
-/// (seed 1) and prints the summary.
-fn run_demo() -> Result<(), String> {
-    let n = 100_000;
-    println!("slivermesh demo: Delaunay tetrahedralization of {n} uniform random points (seed 1)");
-    let points = gen::generate(Kind::Uniform, n, 1);
-    let (_del, stats) = tri::triangulate(&points)?;
-    print!("{}", tri::summary(&stats));
-    Ok(())
 }
 
 fn run_delaunay(

@@ -1,5 +1,6 @@
 //! Binary-private parts of the `slivermesh` command line.
 
 pub mod gen;
+pub mod mesh;
 pub mod rss;
 pub mod tri;

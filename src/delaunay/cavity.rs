@@ -25,6 +25,8 @@ pub(super) struct Scratch {
     faces: Vec<([u32; 3], u32, u32)>,
     /// Tets created by the last insertion.
     pub(super) created: Vec<u32>,
+    /// Vertices of the tets the last insertion deleted.
+    pub(super) removed: Vec<[u32; 4]>,
     /// Directed boundary edge -> face reference of the new tet that owns it.
     edges: FxHashMap<u64, u32>,
 }
@@ -36,6 +38,7 @@ impl Scratch {
             + self.stack.capacity() * 4
             + self.faces.capacity() * 20
             + self.created.capacity() * 4
+            + self.removed.capacity() * 16
             + self.edges.capacity() * 12
     }
 }
@@ -187,7 +190,9 @@ impl Delaunay {
             s.faces
                 .push((face, self.tets[t as usize].n[i as usize], tag));
         }
+        s.removed.clear();
         for &t in &s.cavity {
+            s.removed.push(self.tets[t as usize].v);
             self.free_tet(t);
         }
         s.edges.clear();

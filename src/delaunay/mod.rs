@@ -279,6 +279,11 @@ impl Delaunay {
     pub fn set_tag(&mut self, t: u32, tag: u32) {
         self.tags[t as usize] = tag;
     }
+    /// Vertex quadruples of the tets deleted by the last successful insertion.
+    pub fn last_removed(&self) -> &[[u32; 4]] {
+        &self.scratch.removed
+    }
+
     /// A finite tet whose closure contains `p`, or a hull tet with `p` beyond its hull face.
     pub fn locate_point(&mut self, p: DVec3, hint: Option<u32>) -> u32 {
         let hint = hint.filter(|&t| self.is_alive(t)).unwrap_or(self.last);

@@ -32,7 +32,6 @@ pub struct Segment {
 
 pub struct Domain {
     pub dt: Delaunay,
-    pub n_input: usize,
     pub kind: Vec<VertexKind>,
     pub segments: Vec<Segment>,
     /// Current subsegments (sorted endpoint pair) -> input segment.
@@ -111,7 +110,6 @@ impl Domain {
         let acute_vertices = acute_segment_vertices(&input.vertices, &segments);
         Ok(Domain {
             dt,
-            n_input: input.vertices.len(),
             kind: vec![VertexKind::Input; input.vertices.len()],
             subsegs: seg_index,
             segments,
@@ -144,8 +142,8 @@ impl Domain {
                 Ok(id)
             }
             Ok(Inserted::Duplicate(v)) => Err(MeshError::Internal(format!(
-                "split point ({}, {}, {}) coincides with vertex {v}",
-                p.x, p.y, p.z
+                "new {kind:?} point ({}, {}, {}) coincides with vertex {v} ({:?})",
+                p.x, p.y, p.z, self.kind[v as usize]
             ))),
             Err(e) => Err(MeshError::Internal(e.to_string())),
         }

@@ -16,9 +16,10 @@
 //!   normal's side, so that (a, b, c, E) is positively oriented for ccw abc. For coplanar points
 //!   this is exactly "d strictly inside the circumcircle of abc in the plane"; for points a
 //!   rounding error off the plane (float circumcentres, midpoints, non-planar input) it is still
-//!   one consistent lifting (inversion centred at E), so Lawson flips stay consistent. A triangle
-//!   with orient3d(a, b, c, E) <= 0 (possible only for nearly degenerate triangles of non-planar
-//!   points) is treated as never violated.
+//!   one consistent lifting (inversion centred at E), so Lawson flips stay consistent. The test
+//!   of an edge is symmetric (the same answer from both triangles): the sign is read from a side
+//!   whose lifted tet (a, b, c, E) is positive; a nearly flat triangle of points off the plane
+//!   may have a non-positive one, and if both sides do, the edge counts as Delaunay.
 //! - **Ties** (cocircular points, everywhere on axis-aligned grids) count as "not inside": the
 //!   existing diagonal stays. [`FacetMesh::flip`] lets the caller pick the other one (e.g. to
 //!   match the 3D triangulation's symbolic tie-break).
@@ -32,7 +33,7 @@
 //! visibility walk (Devillers et al., terminates in any triangulation) and "is p in the facet"
 //! is "is the triangle found inside". Triangles are never deleted (every operation splits or
 //! flips), so there is no free list. Construction: incremental Delaunay insertion of the polygon
-//! vertices (Lawson flips), recovery of each polygon edge by Sloan's flip algorithm (a vertex
+//! vertices in BRIO order (Lawson flips), recovery of each polygon edge by Sloan's flip algorithm (a vertex
 //! lying exactly on the edge splits it), flood fill from the super-triangle, from the inner side
 //! of hole polygons and from hole points (bounded by constrained edges), then Lawson flips to the
 //! constrained Delaunay triangulation. `insert`/`split_edge` cost a walk plus O(flips).
@@ -46,17 +47,32 @@
 //!   invert an adjacent triangle is refused ([`SplitError::WouldInvert`]).
 //! - [`FacetMesh::validate`]'s area check assumes outer polygons do not nest and is skipped when
 //!   hole points are used (their extent is not given as polygons).
+//! - Points off the plane by far more than rounding, relative to the local spacing (e.g. 1e-9
+//!   off the plane and 1e-10 from an edge), can leave an edge that the lifted test calls
+//!   non-Delaunay but whose quadrilateral is not convex in the projection, so it cannot flip;
+//!   `validate` then reports it. A rounding error off the plane (float circumcentres and
+//!   midpoints) did not trigger this in randomized tests.
 
+use crate::delaunay::hilbert::brio_order;
 use crate::geom::{check_coordinate, insphere, orient3d};
 use glam::{DVec2, DVec3};
 use rustc_hash::FxHashMap;
 use std::collections::VecDeque;
-use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
 /// "No neighbour" (super-triangle hull edge) / global id of the temporary vertices.
 const NONE: u32 = u32::MAX;
 /// Flag bit: triangle is part of the facet.
 const INSIDE: u8 = 8;
+
+/// Returns `Err(format!(..))` unless the condition holds.
+macro_rules! ensure {
+    ($c:expr, $($m:tt)+) => {
+        let ok: bool = $c;
+        if !ok {
+            return Err(format!($($m)+));
+        }
+    };
+}
 
 #[inline(always)]
 fn nx(i: usize) -> usize {
@@ -127,7 +143,8 @@ pub enum InsertError {
     Outside,
     /// The point projects exactly onto this existing vertex.
     OnVertex(u32),
-    /// The point lies exactly on this subsegment: use [`FacetMesh::split_edge`].
+    /// The point lies exactly on this subsegment (smaller id first): use
+    /// [`FacetMesh::split_edge`].
     OnConstrainedEdge(u32, u32),
     /// The id is already a vertex of this facet (or is `u32::MAX`, reserved).
     IdInUse(u32),
@@ -150,30 +167,20 @@ pub enum SplitError {
 
 impl std::fmt::Display for InsertError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            InsertError::Outside => write!(f, "point outside the facet"),
-            InsertError::OnVertex(v) => write!(f, "point coincides with vertex {v}"),
-            InsertError::OnConstrainedEdge(a, b) => write!(f, "point on subsegment ({a}, {b})"),
-            InsertError::IdInUse(v) => write!(f, "vertex id {v} already used"),
-            InsertError::NotFinite => write!(f, "point is not finite"),
-        }
+        write!(f, "facet insertion refused: {self:?}")
     }
 }
 impl std::error::Error for InsertError {}
 
 impl std::fmt::Display for SplitError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            SplitError::NotAnEdge(a, b) => write!(f, "({a}, {b}) is not an edge of the facet"),
-            SplitError::IdInUse(v) => write!(f, "vertex id {v} already used"),
-            SplitError::NotFinite => write!(f, "point is not finite"),
-            SplitError::WouldInvert => write!(f, "split point too far off the segment"),
-        }
+        write!(f, "facet edge split refused: {self:?}")
     }
 }
 impl std::error::Error for SplitError {}
 
 /// A facet's constrained Delaunay triangulation; see the module documentation.
+#[derive(Clone, Debug)]
 pub struct FacetMesh {
     tris: Vec<Tri>,
     /// Local vertex -> global id (NONE for the 3 super-triangle vertices, locals 0..3).
@@ -191,37 +198,8 @@ pub struct FacetMesh {
     eye: DVec3,
     n_inside: usize,
     expected_area: Option<f64>,
-    /// Walk start (last triangle found); atomic so that `locate(&self)` can update it.
-    hint: AtomicU32,
-}
-
-impl Clone for FacetMesh {
-    fn clone(&self) -> Self {
-        FacetMesh {
-            tris: self.tris.clone(),
-            gid: self.gid.clone(),
-            p3: self.p3.clone(),
-            p2: self.p2.clone(),
-            vtri: self.vtri.clone(),
-            local: self.local.clone(),
-            axes: self.axes,
-            normal: self.normal,
-            eye: self.eye,
-            n_inside: self.n_inside,
-            expected_area: self.expected_area,
-            hint: AtomicU32::new(self.hint.load(Relaxed)),
-        }
-    }
-}
-
-impl std::fmt::Debug for FacetMesh {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("FacetMesh")
-            .field("vertices", &self.num_vertices())
-            .field("triangles", &self.n_inside)
-            .field("normal", &self.normal)
-            .finish()
-    }
+    /// Walk start: a triangle at the last inserted vertex.
+    hint: u32,
 }
 
 /// Vector area (twice the area, along the right-hand normal) of a closed polygon.
@@ -272,83 +250,59 @@ impl FacetMesh {
         hole_points: &[DVec3],
     ) -> Result<FacetMesh, String> {
         let clean = |poly: &Vec<u32>| {
-            let mut c: Vec<u32> = Vec::with_capacity(poly.len());
-            for &v in poly {
-                if c.last() != Some(&v) {
-                    c.push(v);
-                }
-            }
+            let mut c = poly.clone();
+            c.dedup();
             while c.len() > 1 && c.first() == c.last() {
                 c.pop();
             }
             c
         };
         let outer: Vec<Vec<u32>> = outer.iter().map(clean).filter(|p| !p.is_empty()).collect();
-        let holes: Vec<Vec<u32>> = holes.iter().map(clean).filter(|p| !p.is_empty()).collect();
-        let mut ids: Vec<u32> = Vec::new();
-        let mut seen = FxHashMap::default();
+        let holes: Vec<Vec<u32>> = holes.iter().map(clean).collect();
+        let (mut ids, mut seen) = (Vec::new(), FxHashMap::default());
+        let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
         for &id in outer.iter().chain(&holes).flatten() {
-            let p = *points
-                .get(id as usize)
-                .ok_or_else(|| format!("vertex id {id} out of range ({} points)", points.len()))?;
+            ensure!((id as usize) < points.len(), "vertex id {id} out of range");
+            let p = points[id as usize];
             check_coordinate(p).map_err(|e| format!("vertex {id} at {p}: {e}"))?;
             if seen.insert(id, ()).is_none() {
+                (lo, hi) = (lo.min(p), hi.max(p));
                 ids.push(id);
             }
         }
         for &h in hole_points {
             check_coordinate(h).map_err(|e| format!("hole point {h}: {e}"))?;
         }
+        let short = holes.iter().find(|h| h.len() < 3);
+        ensure!(short.is_none(), "hole {short:?}: under 3 vertices");
 
-        // Normal and projection from the outer polygon with the largest area.
+        // Normal and projection from the outer polygon with the largest area; the exact winding
+        // at its extreme vertex orders the 2D axes so that it is counter-clockwise.
         let (best, nrm) = outer
             .iter()
             .filter(|p| p.len() >= 3)
             .map(|p| (p, newell(points, p)))
             .max_by(|a, b| a.1.length_squared().total_cmp(&b.1.length_squared()))
             .ok_or("facet has no outer polygon with 3 or more vertices")?;
-        if nrm.length_squared() == 0.0 || !nrm.is_finite() {
-            return Err(format!("outer polygon {best:?} has no area"));
-        }
-        let a = nrm.abs();
-        let k = if a.x >= a.y && a.x >= a.z {
-            0
-        } else if a.y >= a.z {
-            1
-        } else {
-            2
-        };
+        let k = (0..3).fold(0, |k, i| if nrm[i].abs() > nrm[k].abs() { i } else { k });
+        let ok = nrm[k] != 0.0 && nrm.is_finite();
+        ensure!(ok, "outer polygon {best:?} has no area");
         let cyc = [(k + 1) % 3, (k + 2) % 3];
-        let at = |ax: [usize; 2], id: u32| {
+        let (w, m) = winding(best, |id| {
             let p = points[id as usize];
-            DVec2::new(p[ax[0]], p[ax[1]])
-        };
-        let (w, m) = winding(best, |id| at(cyc, id));
-        if w == 0.0 {
-            return Err(format!(
-                "outer polygon {best:?} is degenerate or not simple"
-            ));
-        }
-        let (axes, s) = if w > 0.0 {
-            (cyc, 1.0)
-        } else {
-            ([cyc[1], cyc[0]], -1.0)
-        };
+            DVec2::new(p[cyc[0]], p[cyc[1]])
+        });
+        ensure!(w != 0.0, "polygon {best:?} degenerate/not simple");
+        let s = w.signum();
+        let axes = if s > 0.0 { cyc } else { [cyc[1], cyc[0]] };
         let normal = nrm.normalize() * if nrm[k] * s < 0.0 { -1.0 } else { 1.0 };
-
-        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-        for &id in &ids {
-            lo = lo.min(points[id as usize]);
-            hi = hi.max(points[id as usize]);
-        }
-        let ext = (hi - lo).max_element();
-        let v0 = points[best[m] as usize];
-        let eye = v0 + DVec3::AXES[k] * (s * ext);
+        // The lifting point: above the polygon's extreme vertex, on the normal's side.
         let n = best.len();
-        let tri3 = [best[(m + n - 1) % n], best[m], best[(m + 1) % n]].map(|i| points[i as usize]);
-        if orient3d(tri3[0], tri3[1], tri3[2], eye) <= 0.0 {
-            return Err(format!("facet polygon {best:?} is too far from planar"));
-        }
+        let v0 = points[best[m] as usize];
+        let eye = v0 + DVec3::AXES[k] * (s * (hi - lo).max_element());
+        let [a, b] = [best[(m + n - 1) % n], best[(m + 1) % n]].map(|i| points[i as usize]);
+        let ok = orient3d(a, v0, b, eye) > 0.0;
+        ensure!(ok, "polygon {best:?} is too far from planar");
 
         let mut fm = FacetMesh {
             tris: Vec::with_capacity(2 * ids.len() + 8),
@@ -362,64 +316,40 @@ impl FacetMesh {
             eye,
             n_inside: 0,
             expected_area: None,
-            hint: AtomicU32::new(0),
+            hint: 0,
         };
-        // Super-triangle, well around the projected bounding box, its vertices put (in float)
-        // on the plane through v0 so that the lifting treats them like the others.
-        let (mut lo2, mut hi2) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
-        for &id in &ids {
-            lo2 = lo2.min(at(axes, id));
-            hi2 = hi2.max(at(axes, id));
-        }
-        let c = (lo2 + hi2) * 0.5;
-        let r = (hi2 - lo2).max_element() * 0.5;
-        for d in [
-            DVec2::new(-20.0, -10.0),
-            DVec2::new(20.0, -10.0),
-            DVec2::new(0.0, 20.0),
-        ] {
-            let q = c + d * r;
-            let mut p = DVec3::ZERO;
-            p[axes[0]] = q.x;
-            p[axes[1]] = q.y;
-            p[k] = v0[k]
-                - (nrm[axes[0]] * (q.x - v0[axes[0]]) + nrm[axes[1]] * (q.y - v0[axes[1]]))
-                    / nrm[k];
+        // Super-triangle well around the bounding box, its vertices put (in float) on the plane
+        // through v0 so that the lifting treats them like the others.
+        let (lo2, hi2) = (fm.proj(lo), fm.proj(hi));
+        let (c, r) = ((lo2 + hi2) * 0.5, (hi2 - lo2).max_element() * 0.5);
+        for (du, dv) in [(-20.0, -10.0), (20.0, -10.0), (0.0, 20.0)] {
+            let (mut p, [iu, iv]) = (DVec3::ZERO, axes);
+            (p[iu], p[iv]) = (c.x + du * r, c.y + dv * r);
+            p[k] = v0[k] - (nrm[iu] * (p[iu] - v0[iu]) + nrm[iv] * (p[iv] - v0[iv])) / nrm[k];
             fm.add_vertex(NONE, p);
         }
-        fm.tris.push(Tri {
-            v: [0, 1, 2],
-            n: [NONE; 3],
-            f: 0,
-        });
-        fm.vtri = vec![0; 3];
-
-        for &id in &ids {
+        fm.new_tri();
+        fm.put(0, [0, 1, 2], 0);
+        // BRIO + Hilbert order: points along a polygon in order (e.g. a circle) would cost O(n)
+        // flips each; this keeps construction near O(n log n).
+        let order = brio_order(
+            &ids.iter().map(|&i| points[i as usize]).collect::<Vec<_>>(),
+            1,
+        );
+        for id in order.into_iter().map(|k| ids[k as usize]) {
             let p = points[id as usize];
-            let l = match fm.walk(fm.proj(p)) {
-                Loc::In(t) => {
-                    let l = fm.add_vertex(id, p);
-                    let new = fm.split_tri(t, l);
-                    fm.legalize(l, new.to_vec(), &mut Vec::new());
-                    l
-                }
-                Loc::Edge(t, i) => {
-                    let l = fm.add_vertex(id, p);
-                    let new = fm.split_edge_at(t, i, l);
-                    fm.legalize(l, new.to_vec(), &mut Vec::new());
-                    l
-                }
+            match fm.walk(fm.proj(p)) {
                 Loc::Vertex(t, i) => {
                     let other = fm.gid[fm.tris[t as usize].v[i] as usize];
-                    return Err(format!(
-                        "vertices {other} and {id} coincide in the facet's projection (at {p})"
-                    ));
+                    return Err(format!("vertices {other} and {id} coincide ({p})"));
                 }
-                Loc::Outside => {
-                    return Err(format!("internal: vertex {id} outside super-triangle"))
+                Loc::Outside => return Err(format!("internal: vertex {id} off super-triangle")),
+                loc => {
+                    let (l, new) = fm.place(loc, id, p);
+                    fm.legalize(l, new, &mut Vec::new());
+                    fm.hint = fm.vtri[l as usize];
                 }
-            };
-            fm.hint.store(fm.vtri[l as usize], Relaxed);
+            }
         }
 
         let loc = |fm: &FacetMesh, id: u32| fm.local[&id];
@@ -428,74 +358,51 @@ impl FacetMesh {
                 fm.recover(loc(&fm, a), loc(&fm, b))?;
             }
         }
-        // Seeds of the removed regions: the super-triangle, the inner side of hole polygons,
-        // hole points.
+        // Flood fill the removed regions from the super-triangle, the inner side of each hole
+        // polygon edge and the hole points; constrained edges bound it.
         let mut seeds = vec![fm.vtri[0]];
         for poly in &holes {
             let (w, _) = winding(poly, |id| fm.p2[loc(&fm, id) as usize]);
-            if poly.len() >= 3 && w == 0.0 {
-                return Err(format!("hole polygon {poly:?} is degenerate or not simple"));
-            }
+            ensure!(w != 0.0, "hole {poly:?} degenerate/not simple");
             for (a, b) in poly_edges(poly) {
-                let chain = fm.recover(loc(&fm, a), loc(&fm, b))?;
-                for e in chain.windows(2) {
+                for e in fm.recover(loc(&fm, a), loc(&fm, b))?.windows(2) {
                     let (t, i) = fm.find_edge(e[0], e[1]).unwrap();
                     let left = fm.tris[t as usize].v[nx(i)] == e[0];
-                    let side = if left == (w > 0.0) {
-                        t
-                    } else {
-                        fm.tris[t as usize].n[i] / 3
-                    };
-                    seeds.push(side);
+                    let other = fm.tris[t as usize].n[i] / 3;
+                    seeds.push(if left == (w > 0.0) { t } else { other });
                 }
             }
         }
         for &h in hole_points {
-            match fm.walk(fm.proj(h)) {
-                Loc::In(t) | Loc::Edge(t, _) | Loc::Vertex(t, _) => seeds.push(t),
-                Loc::Outside => {}
+            if let Loc::In(t) | Loc::Edge(t, _) | Loc::Vertex(t, _) = fm.walk(fm.proj(h)) {
+                seeds.push(t);
             }
         }
         let mut out = vec![false; fm.tris.len()];
         while let Some(t) = seeds.pop() {
-            if std::mem::replace(&mut out[t as usize], true) {
-                continue;
-            }
-            let tr = fm.tris[t as usize];
-            for i in 0..3 {
-                if !tr.cons(i) && tr.n[i] != NONE {
-                    seeds.push(tr.n[i] / 3);
-                }
+            if !std::mem::replace(&mut out[t as usize], true) {
+                let tr = fm.tris[t as usize];
+                let open = |&i: &usize| !tr.cons(i) && tr.n[i] != NONE;
+                seeds.extend((0..3).filter(open).map(|i| tr.n[i] / 3));
             }
         }
-        for (t, tr) in fm.tris.iter_mut().enumerate() {
-            if !out[t] {
-                tr.f |= INSIDE;
-                fm.n_inside += 1;
-            }
+        for (tr, _) in fm.tris.iter_mut().zip(&out).filter(|(_, &o)| !o) {
+            tr.f |= INSIDE;
+            fm.n_inside += 1;
         }
-        if fm.n_inside == 0 {
-            return Err("the facet has no area left (holes cover it)".into());
-        }
+        ensure!(fm.n_inside > 0, "holes cover the whole facet");
         for tr in &fm.tris {
-            for i in 0..3 {
-                if tr.cons(i) && !tr.inside() && !fm.tris[(tr.n[i] / 3) as usize].inside() {
-                    let (a, b) = (fm.gid[tr.v[nx(i)] as usize], fm.gid[tr.v[pv(i)] as usize]);
-                    return Err(format!("polygon edge ({a}, {b}) lies outside the facet"));
+            for i in (0..3).filter(|&i| tr.cons(i) && !tr.inside()) {
+                if !fm.tris[(tr.n[i] / 3) as usize].inside() {
+                    let e = fm.edge_ids(tr, i);
+                    return Err(format!("polygon edge {e:?} lies outside the facet"));
                 }
             }
         }
         fm.make_cdt()?;
-        let t = (0..fm.tris.len()).find(|&t| fm.tris[t].inside()).unwrap();
-        fm.hint.store(t as u32, Relaxed);
+        fm.hint = fm.tris.iter().position(|t| t.inside()).unwrap() as u32;
         if hole_points.is_empty() {
-            let area = |p: &Vec<u32>| {
-                if p.len() >= 3 {
-                    0.5 * newell(points, p).length()
-                } else {
-                    0.0
-                }
-            };
+            let area = |p: &Vec<u32>| 0.5 * newell(points, p).length(); // 0 for 1 or 2 vertices
             let a: f64 = outer.iter().map(area).sum::<f64>() - holes.iter().map(area).sum::<f64>();
             fm.expected_area = Some(a);
         }
@@ -513,8 +420,8 @@ impl FacetMesh {
         if !p.is_finite() {
             return Err(InsertError::NotFinite);
         }
-        let mut removed = Vec::new();
-        let (l, new) = match self.walk(self.proj(p)) {
+        let loc = self.walk(self.proj(p));
+        let (t, i) = match loc {
             Loc::Outside => return Err(InsertError::Outside),
             Loc::Vertex(t, i) => {
                 let v = self.tris[t as usize].v[i];
@@ -523,32 +430,22 @@ impl FacetMesh {
                     None => Err(InsertError::Outside),
                 };
             }
-            Loc::Edge(t, i) => {
-                let tr = self.tris[t as usize];
-                if tr.cons(i) {
-                    let (a, b) = (tr.v[nx(i)], tr.v[pv(i)]);
-                    return Err(InsertError::OnConstrainedEdge(
-                        self.gid[a as usize],
-                        self.gid[b as usize],
-                    ));
-                }
-                if !tr.inside() {
-                    return Err(InsertError::Outside);
-                }
-                removed.push(self.gtri(t));
-                removed.push(self.gtri(tr.n[i] / 3));
-                let l = self.add_vertex(id, p);
-                (l, self.split_edge_at(t, i, l).to_vec())
-            }
-            Loc::In(t) => {
-                if !self.tris[t as usize].inside() {
-                    return Err(InsertError::Outside);
-                }
-                removed.push(self.gtri(t));
-                let l = self.add_vertex(id, p);
-                (l, self.split_tri(t, l).to_vec())
-            }
+            Loc::Edge(t, i) => (t, i),
+            Loc::In(t) => (t, 3),
         };
+        let tr = self.tris[t as usize];
+        if i < 3 && tr.cons(i) {
+            let [a, b] = self.edge_ids(&tr, i);
+            return Err(InsertError::OnConstrainedEdge(a, b));
+        }
+        if !tr.inside() {
+            return Err(InsertError::Outside);
+        }
+        let mut removed = vec![self.gtri(t)];
+        if i < 3 {
+            removed.push(self.gtri(tr.n[i] / 3));
+        }
+        let (l, new) = self.place(loc, id, p);
         self.n_inside += 2;
         Ok(self.finish(l, new, removed))
     }
@@ -556,7 +453,7 @@ impl FacetMesh {
     /// Splits the edge (a, b) (normally a subsegment) at vertex `id` placed at `p`, a point
     /// near the segment (a float midpoint: need not be exactly on it). The edge is replaced by
     /// a-p and p-b, both constrained if ab was; the one or two adjacent facet triangles are split,
-    /// then Lawson flips restore the constrained Delaunay property.
+    /// then Lawson flips restore the constrained Delaunay property. On error nothing changes.
     pub fn split_edge(&mut self, a: u32, b: u32, id: u32, p: DVec3) -> Result<Change, SplitError> {
         if id == NONE || self.local.contains_key(&id) {
             return Err(SplitError::IdInUse(id));
@@ -586,9 +483,8 @@ impl FacetMesh {
                 self.n_inside += 1;
             }
         }
-        let l = self.add_vertex(id, p);
-        let new = self.split_edge_at(t, i, l);
-        Ok(self.finish(l, new.to_vec(), removed))
+        let (l, new) = self.place(Loc::Edge(t, i), id, p);
+        Ok(self.finish(l, new, removed))
     }
 
     /// Flips the non-constrained facet edge (a, b) if its quadrilateral is strictly convex
@@ -611,10 +507,8 @@ impl FacetMesh {
         }
         let removed = vec![self.gtri(t), self.gtri(u)];
         self.flip_at(t, i);
-        Some(Change {
-            removed,
-            added: vec![self.gtri(t), self.gtri(u)],
-        })
+        let added = vec![self.gtri(t), self.gtri(u)];
+        Some(Change { removed, added })
     }
 
     /// The facet triangle holding p (projected on the facet plane; closed triangles, a point on
@@ -623,14 +517,10 @@ impl FacetMesh {
         let t = match self.walk(self.proj(p)) {
             Loc::Outside => return None,
             Loc::In(t) => t,
-            Loc::Edge(t, i) => {
-                let u = self.tris[t as usize].n[i];
-                if self.tris[t as usize].inside() || u == NONE {
-                    t
-                } else {
-                    u / 3
-                }
-            }
+            Loc::Edge(t, i) => match self.tris[t as usize].n[i] {
+                u if u != NONE && !self.tris[t as usize].inside() => u / 3,
+                _ => t,
+            },
             Loc::Vertex(t, i) => {
                 let v = self.tris[t as usize].v[i];
                 self.find_in_star(v, |s, _| self.tris[s as usize].inside())
@@ -643,10 +533,7 @@ impl FacetMesh {
     /// All triangles of the facet (global ids, ccw about [`FacetMesh::normal`], smallest id
     /// first).
     pub fn triangles(&self) -> Vec<[u32; 3]> {
-        (0..self.tris.len() as u32)
-            .filter(|&t| self.tris[t as usize].inside())
-            .map(|t| self.gtri(t))
-            .collect()
+        self.facet_tris().map(|t| self.gtri(t)).collect()
     }
 
     /// Number of triangles of the facet.
@@ -656,16 +543,7 @@ impl FacetMesh {
 
     /// The facet triangles around vertex `id` (empty if it is not a vertex).
     pub fn triangles_around(&self, id: u32) -> Vec<[u32; 3]> {
-        let mut out = Vec::new();
-        if let Some(&l) = self.local.get(&id) {
-            self.find_in_star(l, |t, _| {
-                if self.tris[t as usize].inside() {
-                    out.push(self.gtri(t));
-                }
-                false
-            });
-        }
-        out
+        self.local.get(&id).map_or(Vec::new(), |&l| self.star(l))
     }
 
     /// All constrained edges (subsegments), each once as [min id, max id].
@@ -674,11 +552,7 @@ impl FacetMesh {
         for (t, tr) in self.tris.iter().enumerate() {
             for i in 0..3 {
                 if tr.cons(i) && (t as u32) * 3 + (i as u32) < tr.n[i] {
-                    let (a, b) = (
-                        self.gid[tr.v[nx(i)] as usize],
-                        self.gid[tr.v[pv(i)] as usize],
-                    );
-                    out.push([a.min(b), a.max(b)]);
+                    out.push(self.edge_ids(tr, i));
                 }
             }
         }
@@ -702,11 +576,7 @@ impl FacetMesh {
         let side = |s: &Tri, k: usize| s.inside().then(|| self.gid[s.v[k] as usize]);
         let (mine, theirs) = (side(&tr, i), side(&ur, (r % 3) as usize));
         let a_first = self.gid[tr.v[nx(i)] as usize] == a;
-        Some(if a_first {
-            [mine, theirs]
-        } else {
-            [theirs, mine]
-        })
+        Some([[mine, theirs], [theirs, mine]][!a_first as usize])
     }
 
     /// Global ids of all vertices (polygon vertices and inserted ones).
@@ -717,11 +587,6 @@ impl FacetMesh {
     /// Number of vertices.
     pub fn num_vertices(&self) -> usize {
         self.gid.len() - 3
-    }
-
-    /// Whether `id` is a vertex of this facet.
-    pub fn contains_vertex(&self, id: u32) -> bool {
-        self.local.contains_key(&id)
     }
 
     /// The 3D position of vertex `id`.
@@ -736,13 +601,11 @@ impl FacetMesh {
 
     /// Sum of the 3D areas of the facet triangles.
     pub fn area(&self) -> f64 {
-        (0..self.tris.len())
-            .filter(|&t| self.tris[t].inside())
-            .map(|t| {
-                let [a, b, c] = self.tris[t].v.map(|v| self.p3[v as usize]);
-                0.5 * (b - a).cross(c - a).length()
-            })
-            .sum()
+        let area = |t: u32| {
+            let [a, b, c] = self.tris[t as usize].v.map(|v| self.p3[v as usize]);
+            0.5 * (b - a).cross(c - a).length()
+        };
+        self.facet_tris().map(area).sum()
     }
 
     /// Full consistency check (for tests; O(n)): adjacency symmetry, ccw orientation of every
@@ -750,97 +613,61 @@ impl FacetMesh {
     /// constrained Delaunay (no apex strictly inside across a non-constrained facet edge), and
     /// the facet's area against the polygons' area (relative 1e-9; see the module limits).
     pub fn validate(&self) -> Result<(), String> {
-        let nv = self.gid.len();
-        if self.tris.len() != 2 * nv - 5 {
-            return Err(format!("{} triangles for {nv} vertices", self.tris.len()));
-        }
+        let (nv, nt) = (self.gid.len(), self.tris.len());
+        ensure!(nt == 2 * nv - 5, "{nt} triangles for {nv} vertices");
         let mut n_in = 0;
         for (t, tr) in self.tris.iter().enumerate() {
-            let g = |k: usize| self.gid[tr.v[k] as usize];
-            if tr.v.iter().any(|&v| v as usize >= nv) || tr.v[0] == tr.v[1] || tr.v[1] == tr.v[2] {
-                return Err(format!("triangle {t} has bad vertices {:?}", tr.v));
-            }
+            let ([a, b, c], g) = (tr.v, self.gtri(t as u32));
+            let ok = a.max(b).max(c) < nv as u32 && a != b && b != c && c != a;
+            ensure!(ok, "triangle {t}: bad vertices");
             let [a, b, c] = tr.v.map(|v| self.p2[v as usize]);
-            if orient2d(a, b, c) <= 0.0 {
-                return Err(format!(
-                    "triangle {t} ({}, {}, {}) is not ccw",
-                    g(0),
-                    g(1),
-                    g(2)
-                ));
-            }
-            if tr.inside() {
-                n_in += 1;
-                if tr.v.iter().any(|&v| v < 3) {
-                    return Err(format!("facet triangle {t} uses a temporary vertex"));
-                }
-            }
+            ensure!(orient2d(a, b, c) > 0.0, "triangle {g:?} not ccw");
+            n_in += tr.inside() as usize;
+            let ok = !tr.inside() || tr.v.iter().all(|&v| v >= 3);
+            ensure!(ok, "triangle {t} uses a temporary vertex");
             for i in 0..3 {
-                let (x, y) = (tr.v[nx(i)], tr.v[pv(i)]);
-                let r = tr.n[i];
+                let (x, y, r) = (tr.v[nx(i)], tr.v[pv(i)], tr.n[i]);
                 if r == NONE {
-                    if x >= 3 || y >= 3 {
-                        return Err(format!("triangle {t} edge {i} has no neighbour"));
-                    }
+                    ensure!(x < 3 && y < 3, "triangle {t}: no neighbour {i}");
                     continue;
                 }
                 let (u, j) = ((r / 3) as usize, (r % 3) as usize);
-                let ur = self
-                    .tris
-                    .get(u)
-                    .ok_or(format!("triangle {t}: bad neighbour"))?;
-                if ur.n[j] != (t * 3 + i) as u32 || ur.v[nx(j)] != y || ur.v[pv(j)] != x {
-                    return Err(format!("triangles {t} and {u} disagree on their edge"));
-                }
-                if tr.cons(i) != ur.cons(j) {
-                    return Err(format!("triangles {t}, {u}: constrained flag differs"));
-                }
-                if !tr.cons(i) && tr.inside() != ur.inside() {
-                    return Err(format!(
-                        "facet boundary between {t} and {u} not constrained"
-                    ));
-                }
-                if tr.cons(i) && !tr.inside() && !ur.inside() {
-                    return Err(format!("constrained edge of {t} outside the facet"));
-                }
-                if tr.inside() && !tr.cons(i) && self.incircle(tr.v[i], x, y, ur.v[j]) {
-                    return Err(format!(
-                        "edge ({}, {}) not locally Delaunay: {} inside circle of ({}, {}, {})",
-                        g(nx(i)),
-                        g(pv(i)),
-                        self.gid[ur.v[j] as usize],
-                        g(0),
-                        g(1),
-                        g(2)
-                    ));
-                }
+                let ur = self.tris.get(u).ok_or("bad neighbour reference")?;
+                let ok = ur.n[j] == (t * 3 + i) as u32 && ur.v[nx(j)] == y && ur.v[pv(j)] == x;
+                ensure!(ok, "triangles {t}, {u} disagree");
+                let (cons, inside) = (tr.cons(i), tr.inside());
+                ensure!(cons == ur.cons(j), "constrained flag {t}|{u}");
+                let ok = cons || inside == ur.inside();
+                ensure!(ok, "unconstrained boundary {t}|{u}");
+                let ok = !cons || inside || ur.inside();
+                ensure!(ok, "constrained edge {t}|{u} outside");
+                let bad = inside && !cons && self.incircle(tr.v[i], x, y, ur.v[j]);
+                let d = self.gid[ur.v[j] as usize];
+                ensure!(!bad, "{d} in the circle of {g:?}");
             }
         }
-        if n_in != self.n_inside {
-            return Err(format!(
-                "{n_in} facet triangles, counter says {}",
-                self.n_inside
-            ));
-        }
+        ensure!(n_in == self.n_inside, "facet triangle count");
         for v in 0..nv {
-            let t = self.vtri[v] as usize;
-            if self.tris.get(t).and_then(|tr| tr.find(v as u32)).is_none() {
-                return Err(format!("vertex {} has a stale triangle", self.gid[v]));
-            }
-            if v >= 3 && self.local.get(&self.gid[v]) != Some(&(v as u32)) {
-                return Err(format!("vertex {} missing from the id map", self.gid[v]));
-            }
+            let tr = self.tris.get(self.vtri[v] as usize);
+            let ok = tr.and_then(|tr| tr.find(v as u32)).is_some();
+            ensure!(ok, "vertex {} has a stale triangle", self.gid[v]);
+            let ok = v < 3 || self.local.get(&self.gid[v]) == Some(&(v as u32));
+            ensure!(ok, "vertex {} not in the id map", self.gid[v]);
         }
         if let Some(exp) = self.expected_area {
             let got = self.area();
-            if (got - exp).abs() > 1e-9 * exp.abs() {
-                return Err(format!("triangles cover area {got}, polygons have {exp}"));
-            }
+            let ok = (got - exp).abs() <= 1e-9 * exp.abs();
+            ensure!(ok, "triangles' area {got}, polygons' {exp}");
         }
         Ok(())
     }
 
     // ---------------------------------------------------------------- internals
+
+    /// Slots of the facet's triangles.
+    fn facet_tris(&self) -> impl Iterator<Item = u32> + '_ {
+        (0..self.tris.len() as u32).filter(|&t| self.tris[t as usize].inside())
+    }
 
     fn proj(&self, p: DVec3) -> DVec2 {
         DVec2::new(p[self.axes[0]], p[self.axes[1]])
@@ -858,15 +685,38 @@ impl FacetMesh {
         l
     }
 
+    /// Adds vertex `id` at `p` in the triangle or on the edge `loc`; returns its local index and
+    /// the triangles around it.
+    fn place(&mut self, loc: Loc, id: u32, p: DVec3) -> (u32, Vec<u32>) {
+        let l = self.add_vertex(id, p);
+        match loc {
+            Loc::In(t) => (l, self.split_tri(t, l).to_vec()),
+            Loc::Edge(t, i) => (l, self.split_edge_at(t, i, l)),
+            _ => unreachable!("place: {loc:?}"),
+        }
+    }
+
+    /// The vertex across neighbour reference `r` (the apex of the other triangle).
+    fn apex(&self, r: u32) -> u32 {
+        self.tris[(r / 3) as usize].v[(r % 3) as usize]
+    }
+
     /// A triangle's global ids, canonical.
     fn gtri(&self, t: u32) -> [u32; 3] {
         canon(self.tris[t as usize].v.map(|v| self.gid[v as usize]))
     }
 
-    /// Exact "d strictly inside the circle of ccw (a, b, c)" through the lifting from `eye`.
+    /// Exact "d strictly inside the circle of ccw (a, b, c)" through the lifting from `eye`,
+    /// for d across edge (b, c). Symmetric: equals "a inside the circle of (d, c, b)". It reads
+    /// the sign from a triangle whose lifted tet is positive; a nearly flat triangle of points
+    /// off the plane may have a non-positive one, and if both do the edge is left as it is.
     fn incircle(&self, a: u32, b: u32, c: u32, d: u32) -> bool {
         let [a, b, c, d] = [a, b, c, d].map(|v| self.p3[v as usize]);
-        orient3d(a, b, c, self.eye) > 0.0 && insphere(a, b, c, self.eye, d) > 0.0
+        if orient3d(a, b, c, self.eye) > 0.0 {
+            insphere(a, b, c, self.eye, d) > 0.0
+        } else {
+            orient3d(d, c, b, self.eye) > 0.0 && insphere(d, c, b, self.eye, a) > 0.0
+        }
     }
 
     /// Whether replacing diagonal (x, y) of the quad (c, x, d, y) by (c, d) gives two ccw
@@ -1000,9 +850,7 @@ impl FacetMesh {
         if tr.cons(i) || tr.n[i] == NONE {
             return false;
         }
-        let r = tr.n[i];
-        let d = self.tris[(r / 3) as usize].v[(r % 3) as usize];
-        let (c, x, y) = (tr.v[i], tr.v[nx(i)], tr.v[pv(i)]);
+        let (c, x, y, d) = (tr.v[i], tr.v[nx(i)], tr.v[pv(i)], self.apex(tr.n[i]));
         self.incircle(c, x, y, d) && self.convex(c, x, y, d)
     }
 
@@ -1032,15 +880,21 @@ impl FacetMesh {
     /// Lawson flips after an insertion, then the Change (added = facet triangles around `l`).
     fn finish(&mut self, l: u32, new: Vec<u32>, mut removed: Vec<[u32; 3]>) -> Change {
         self.legalize(l, new, &mut removed);
-        self.hint.store(self.vtri[l as usize], Relaxed);
-        let mut added = Vec::new();
+        self.hint = self.vtri[l as usize];
+        let added = self.star(l);
+        Change { removed, added }
+    }
+
+    /// The facet triangles (global ids) around local vertex `l`.
+    fn star(&self, l: u32) -> Vec<[u32; 3]> {
+        let mut out = Vec::new();
         self.find_in_star(l, |t, _| {
             if self.tris[t as usize].inside() {
-                added.push(self.gtri(t));
+                out.push(self.gtri(t));
             }
             false
         });
-        Change { removed, added }
+        out
     }
 
     /// Visits the triangles around local vertex `v` as (triangle, index of v) until `f` says
@@ -1083,11 +937,7 @@ impl FacetMesh {
             v[nx(k)] == b || v[pv(k)] == b
         })?;
         let v = self.tris[t as usize].v;
-        Some(if v[nx(k)] == b {
-            (t, pv(k))
-        } else {
-            (t, nx(k))
-        })
+        Some((t, if v[nx(k)] == b { pv(k) } else { nx(k) }))
     }
 
     /// Edge (a, b) by global ids, if it is an edge with a facet triangle on one side.
@@ -1101,11 +951,7 @@ impl FacetMesh {
 
     /// Stochastic visibility walk from the hint to projected point q.
     fn walk(&self, q: DVec2) -> Loc {
-        let mut t = self.hint.load(Relaxed);
-        if t as usize >= self.tris.len() {
-            t = 0;
-        }
-        let mut came = 3;
+        let (mut t, mut came) = (self.hint, 3);
         let mut rng = (q.x.to_bits() ^ q.y.to_bits().rotate_left(29)) as u32 | 1;
         for _ in 0..4 * self.tris.len() + 64 {
             let tr = self.tris[t as usize];
@@ -1120,11 +966,7 @@ impl FacetMesh {
                 if i == came {
                     continue;
                 }
-                let o = orient2d(
-                    self.p2[tr.v[nx(i)] as usize],
-                    self.p2[tr.v[pv(i)] as usize],
-                    q,
-                );
+                let o = self.side(&tr, i, q);
                 if o < 0.0 {
                     next = Some(i);
                     break;
@@ -1138,21 +980,12 @@ impl FacetMesh {
                     }
                     (t, came) = (tr.n[i] / 3, (tr.n[i] % 3) as usize);
                 }
-                None => {
-                    self.hint.store(t, Relaxed);
-                    return Self::classify(t, zero);
-                }
+                None => return Self::classify(t, zero),
             }
         }
         // Unreachable in practice (the stochastic walk terminates); scan as a fallback.
         for (t, tr) in self.tris.iter().enumerate() {
-            let o = [0, 1, 2].map(|i| {
-                orient2d(
-                    self.p2[tr.v[nx(i)] as usize],
-                    self.p2[tr.v[pv(i)] as usize],
-                    q,
-                )
-            });
+            let o = [0, 1, 2].map(|i| self.side(tr, i, q));
             if o.iter().all(|&x| x >= 0.0) {
                 return Self::classify(t as u32, o.map(|x| x == 0.0));
             }
@@ -1160,15 +993,24 @@ impl FacetMesh {
         Loc::Outside
     }
 
+    /// orient2d of edge `i` of `tr` (as the triangle runs) and q: > 0 on the triangle's side.
+    fn side(&self, tr: &Tri, i: usize, q: DVec2) -> f64 {
+        let [a, b] = [nx(i), pv(i)].map(|k| self.p2[tr.v[k] as usize]);
+        orient2d(a, b, q)
+    }
+
+    /// Global ids of edge `i` of `tr`, smaller first.
+    fn edge_ids(&self, tr: &Tri, i: usize) -> [u32; 2] {
+        let [a, b] = [nx(i), pv(i)].map(|k| self.gid[tr.v[k] as usize]);
+        [a.min(b), a.max(b)]
+    }
+
     fn classify(t: u32, zero: [bool; 3]) -> Loc {
-        match zero {
-            [false, false, false] => Loc::In(t),
-            [true, false, false] => Loc::Edge(t, 0),
-            [false, true, false] => Loc::Edge(t, 1),
-            [false, false, true] => Loc::Edge(t, 2),
-            [false, true, true] => Loc::Vertex(t, 0),
-            [true, false, true] => Loc::Vertex(t, 1),
-            _ => Loc::Vertex(t, 2),
+        let pos = |z: bool| zero.iter().position(|&x| x == z).unwrap();
+        match zero.iter().filter(|&&z| z).count() {
+            0 => Loc::In(t),
+            1 => Loc::Edge(t, pos(true)),
+            _ => Loc::Vertex(t, pos(false)),
         }
     }
 
@@ -1182,9 +1024,7 @@ impl FacetMesh {
             if !cross.is_empty() {
                 self.flip_out(s, e, cross)?;
             }
-            let (t, i) = self
-                .find_edge(s, e)
-                .ok_or("internal: recovered edge missing")?;
+            let (t, i) = self.find_edge(s, e).ok_or("internal: lost edge")?;
             self.tris[t as usize].f |= 1 << i;
             let r = self.tris[t as usize].n[i];
             self.tris[(r / 3) as usize].f |= 1 << (r % 3);
@@ -1218,22 +1058,13 @@ impl FacetMesh {
             let tr = self.tris[t as usize];
             let (v1, v2) = (tr.v[nx(e)], tr.v[pv(e)]);
             if tr.cons(e) {
-                let g = |v: u32| self.gid[v as usize];
-                return Err(format!(
-                    "polygon edges cross: ({}, {}) and ({}, {})",
-                    g(s),
-                    g(b),
-                    g(v1),
-                    g(v2)
-                ));
+                let [s, b, v1, v2] = [s, b, v1, v2].map(|v| self.gid[v as usize]);
+                return Err(format!("polygon edges cross: ({s}, {b}) and ({v1}, {v2})"));
             }
             cross.push((v1, v2));
             let r = tr.n[e];
-            if r == NONE {
-                return Err("internal: constraint left the super-triangle".into());
-            }
-            let (u, j) = (r / 3, (r % 3) as usize);
-            let w = self.tris[u as usize].v[j];
+            ensure!(r != NONE, "internal: constraint left the super-triangle");
+            let (u, j, w) = (r / 3, (r % 3) as usize, self.apex(r));
             if w == b {
                 return Ok((b, cross));
             }
@@ -1252,13 +1083,9 @@ impl FacetMesh {
         let mut queue: VecDeque<(u32, u32)> = cross.into();
         let mut stall = 0;
         while let Some((x, y)) = queue.pop_front() {
-            let (t, i) = self
-                .find_edge(x, y)
-                .ok_or("internal: crossing edge vanished")?;
+            let (t, i) = self.find_edge(x, y).ok_or("internal: lost edge")?;
             let tr = self.tris[t as usize];
-            let r = tr.n[i];
-            let d = self.tris[(r / 3) as usize].v[(r % 3) as usize];
-            let c = tr.v[i];
+            let (c, d) = (tr.v[i], self.apex(tr.n[i]));
             if self.convex(c, tr.v[nx(i)], tr.v[pv(i)], d) {
                 self.flip_at(t, i);
                 stall = 0;
@@ -1270,41 +1097,23 @@ impl FacetMesh {
             } else {
                 queue.push_back((x, y));
                 stall += 1;
-                if stall > queue.len() {
-                    return Err("internal: edge recovery stalled".into());
-                }
+                ensure!(stall <= queue.len(), "internal: edge recovery stalled");
             }
         }
         Ok(())
     }
 
-    /// Lawson flips over the whole triangulation (after edge recovery).
+    /// Lawson flips over the whole triangulation (after edge recovery). Flips reuse the two
+    /// triangle slots, so a stack of slots stays valid; a flipped pair is checked again.
     fn make_cdt(&mut self) -> Result<(), String> {
-        let mut stack = Vec::new();
-        for (t, tr) in self.tris.iter().enumerate() {
-            for i in 0..3 {
-                if !tr.cons(i) && tr.n[i] != NONE && ((t * 3 + i) as u32) < tr.n[i] {
-                    stack.push((tr.v[nx(i)], tr.v[pv(i)]));
-                }
-            }
-        }
+        let mut stack: Vec<u32> = (0..self.tris.len() as u32).collect();
         let mut budget = self.tris.len().saturating_mul(self.tris.len()) + 10_000;
-        while let Some((a, b)) = stack.pop() {
-            let Some((t, i)) = self.find_edge(a, b) else {
-                continue;
-            };
-            if !self.should_flip(t, i) {
-                continue;
+        while let Some(t) = stack.pop() {
+            if let Some(i) = (0..3).find(|&i| self.should_flip(t, i)) {
+                ensure!(budget > 0, "internal: too many flips");
+                budget -= 1;
+                stack.extend([t, self.flip_at(t, i)]);
             }
-            if budget == 0 {
-                return Err("internal: too many flips (is the facet planar?)".into());
-            }
-            budget -= 1;
-            let tr = self.tris[t as usize];
-            let d = self.tris[(tr.n[i] / 3) as usize].v[(tr.n[i] % 3) as usize];
-            let (c, x, y) = (tr.v[i], tr.v[nx(i)], tr.v[pv(i)]);
-            self.flip_at(t, i);
-            stack.extend([(c, x), (x, d), (d, y), (y, c)]);
         }
         Ok(())
     }
@@ -1312,5 +1121,364 @@ impl FacetMesh {
 
 #[cfg(test)]
 mod tests {
-    // TESTS
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+    use std::collections::HashSet;
+
+    /// `f(s, t)` for flat (s, t) pairs.
+    fn map2(c: &[f64], f: impl Fn(f64, f64) -> DVec3) -> Vec<DVec3> {
+        c.chunks(2).map(|c| f(c[0], c[1])).collect()
+    }
+    fn xy(c: &[f64]) -> Vec<DVec3> {
+        map2(c, p)
+    }
+    fn p(x: f64, y: f64) -> DVec3 {
+        DVec3::new(x, y, 0.0)
+    }
+    const SQUARE: [f64; 8] = [0., 0., 1., 0., 1., 1., 0., 1.];
+    const SQUARE_HOLE: [f64; 16] = [
+        0., 0., 4., 0., 4., 4., 0., 4., 1., 1., 3., 1., 3., 3., 1., 3.,
+    ];
+    /// Points of the plane through `o` spanned by `u`, `v` (exact for small integer s, t).
+    fn plane(o: DVec3, u: DVec3, v: DVec3) -> impl Fn(f64, f64) -> DVec3 {
+        move |s, t| o + u * s + v * t
+    }
+
+    /// Keeps a set of subfacets in sync through the Change lists and checks it.
+    struct Tracker(HashSet<[u32; 3]>);
+    impl Tracker {
+        fn new(m: &FacetMesh) -> Self {
+            Tracker(m.triangles().into_iter().collect())
+        }
+        fn apply(&mut self, ch: &Change, m: &FacetMesh) {
+            assert!(
+                ch.removed.iter().all(|r| self.0.remove(r)),
+                "removed a non-triangle"
+            );
+            assert!(
+                ch.added.iter().all(|a| self.0.insert(*a)),
+                "added a triangle twice"
+            );
+            assert_eq!(self.0, m.triangles().into_iter().collect::<HashSet<_>>());
+            assert_eq!(self.0.len(), m.num_triangles());
+        }
+    }
+
+    fn check_ccw(m: &FacetMesh) {
+        for t in m.triangles() {
+            let [a, b, c] = t.map(|i| m.point(i).unwrap());
+            assert!((b - a).cross(c - a).dot(m.normal()) > 0.0, "{t:?} not ccw");
+        }
+    }
+
+    /// `n` random operations, each checked against a Tracker: with probability `split` a
+    /// subsegment split at a float point near its middle (not exactly on the line), else an
+    /// insertion of `f(s, t)`, s, t in [0, 1), or (one in four) of the float circumcentre of a
+    /// random subfacet. A refusal must change nothing; a point on a subsegment splits it.
+    /// Validates every 100 steps and at the end.
+    fn drive(m: &mut FacetMesh, n: usize, split: f64, seed: u64, f: impl Fn(f64, f64) -> DVec3) {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let (mut tr, mut id) = (Tracker::new(m), 1_000_000 + m.num_vertices() as u32);
+        for step in 0..n {
+            let before = m.triangles();
+            let ch = if rng.gen_bool(split) {
+                let segs = m.constrained_edges();
+                let [a, b] = segs[rng.gen_range(0..segs.len())];
+                let (pa, pb) = (m.point(a).unwrap(), m.point(b).unwrap());
+                let ch = m.split_edge(a, b, id, pa.lerp(pb, rng.gen_range(0.3..0.7)));
+                assert!(m.is_constrained(a, id) && m.is_constrained(id, b));
+                assert!(!m.is_constrained(a, b));
+                ch.unwrap()
+            } else {
+                let tris = m.triangles();
+                let [a, b, c] = tris[rng.gen_range(0..tris.len())].map(|i| m.point(i).unwrap());
+                let (ab, ac) = (b - a, c - a);
+                let (n, l2) = (ab.cross(ac), [ab.length_squared(), ac.length_squared()]);
+                let cc = a + (n.cross(ab) * l2[1] + ac.cross(n) * l2[0]) / n.length_squared() / 2.;
+                let q = [f(rng.gen(), rng.gen()), cc][rng.gen_bool(0.25) as usize];
+                match m.insert(id, q) {
+                    Ok(ch) => ch,
+                    Err(InsertError::OnConstrainedEdge(a, b)) => m.split_edge(a, b, id, q).unwrap(),
+                    Err(_) => {
+                        assert_eq!(before, m.triangles());
+                        continue;
+                    }
+                }
+            };
+            tr.apply(&ch, m);
+            id += 1;
+            if step % 100 == 0 {
+                m.validate().unwrap_or_else(|e| panic!("step {step}: {e}"));
+            }
+        }
+        m.validate().unwrap();
+        check_ccw(m);
+    }
+
+    #[test]
+    fn unit_square_windings_flips_opposite() {
+        let pts = xy(&SQUARE);
+        let r = FacetMesh::new(&pts, &[vec![3, 2, 1, 0, 3]], &[], &[]).unwrap();
+        r.validate().unwrap();
+        assert_eq!(r.normal(), -DVec3::Z);
+        check_ccw(&r);
+        let mut m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3]], &[], &[]).unwrap();
+        m.validate().unwrap();
+        assert_eq!((m.num_triangles(), m.constrained_edges().len()), (2, 4));
+        assert_eq!((m.normal(), m.area()), (DVec3::Z, 1.0));
+        check_ccw(&m);
+        let (a, b) = [(1, 3), (0, 2)][m.opposite(0, 2).is_some() as usize];
+        let [l, r] = m.opposite(a, b).unwrap();
+        assert!(l.is_some() && r.is_some() && l != r);
+        let c = if a == 0 { 2 } else { 3 };
+        assert_eq!(m.opposite(0, 1).unwrap(), [Some(c), None]);
+        assert_eq!(m.opposite(1, 0).unwrap()[0], None);
+        let mut tr = Tracker::new(&m);
+        let before = tr.0.clone();
+        tr.apply(&m.flip_change(a, b).unwrap(), &m);
+        m.validate().unwrap(); // cocircular: both diagonals are Delaunay
+        assert!(m.opposite(a, b).is_none() && m.flip(l.unwrap(), r.unwrap()));
+        assert_eq!(Tracker::new(&m).0, before);
+        assert!(!m.flip(0, 1) && !m.flip(0, 9));
+        // a non-convex quad does not flip
+        let pts = xy(&[0., 0., 4., 0., 1., 1., 0., 4.]);
+        let mut m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3]], &[], &[]).unwrap();
+        assert!(m.opposite(0, 2).is_some() && !m.flip(0, 2));
+    }
+
+    #[test]
+    fn l_shape_and_holes() {
+        let pts = xy(&[0., 0., 2., 0., 2., 1., 1., 1., 1., 2., 0., 2.]);
+        let mut m = FacetMesh::new(&pts, &[(0..6).collect()], &[], &[]).unwrap();
+        m.validate().unwrap();
+        assert_eq!((m.num_triangles(), m.area()), (4, 3.0));
+        assert_eq!(m.locate(p(1.5, 1.5)), None);
+        assert!(m.locate(p(0.5, 1.5)).is_some() && m.locate(p(1., 1.)).is_some());
+        assert_eq!(m.insert(10, p(1.5, 1.5)), Err(InsertError::Outside));
+        drive(&mut m, 400, 0.2, 7, |x, y| p(2.0 * x, 2.0 * y));
+        assert!(m.num_vertices() > 200 && m.num_vertices() < 400);
+        // square with a square hole given as a polygon of either winding
+        let pts = xy(&SQUARE_HOLE);
+        for hole in [vec![4, 5, 6, 7], vec![7, 6, 5, 4]] {
+            let mut m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3]], &[hole], &[]).unwrap();
+            m.validate().unwrap();
+            assert_eq!((m.num_triangles(), m.constrained_edges().len()), (8, 8));
+            assert_eq!(m.locate(p(2., 2.)), None);
+            drive(&mut m, 300, 0.2, 3, |x, y| p(4. * x, 4. * y));
+            assert!((m.area() - 12.0).abs() < 1e-12);
+        }
+        // TetGen style: the inner polygon is an outer one, the hole is marked by a point
+        let outer = [vec![0, 1, 2, 3], vec![4, 5, 6, 7]];
+        let mut m = FacetMesh::new(&pts, &outer, &[], &[p(2., 2.)]).unwrap();
+        m.validate().unwrap();
+        assert_eq!((m.num_triangles(), m.area()), (8, 12.0));
+        drive(&mut m, 300, 0.2, 4, |x, y| p(4. * x, 4. * y));
+        assert!((m.area() - 12.0).abs() < 1e-12);
+        // without the hole point the inner polygon is only imprinted
+        let m = FacetMesh::new(&pts, &outer, &[], &[]).unwrap();
+        assert_eq!(m.num_triangles(), 10);
+        assert!(m.locate(p(2., 2.)).is_some());
+        // an island inside a hole stays
+        let mut pts = pts.clone();
+        pts.extend(xy(&[1.5, 1.5, 2.5, 1.5, 2.5, 2.5, 1.5, 2.5]));
+        let outer = [vec![0, 1, 2, 3], vec![8, 9, 10, 11]];
+        let m = FacetMesh::new(&pts, &outer, &[vec![4, 5, 6, 7]], &[]).unwrap();
+        m.validate().unwrap();
+        assert_eq!(m.area(), 13.0);
+        assert!(m.locate(p(2., 2.)).is_some() && m.locate(p(1.2, 2.)).is_none());
+    }
+
+    #[test]
+    fn tilted_planes() {
+        // x + 2y + 3z = 6 (dominant axis z) and 3x - y - 2z = -7 (dominant x, reversed winding)
+        let cases = [
+            ([6., 0., 0.], [-2., 1., 0.], [-3., 0., 1.], false),
+            ([1., 2., 3.], [1., 3., 0.], [0., -2., 1.], true),
+        ];
+        for (o, u, v, rev) in cases {
+            let (u, v) = (DVec3::from(u), DVec3::from(v));
+            let f = plane(o.into(), u, v);
+            // an L with a collinear vertex at (4, 0), and a square hole
+            let (c, h) = (
+                [0., 0., 4., 0., 8., 0., 8., 4., 4., 4., 4., 8., 0., 8.],
+                [1., 1., 3., 1.],
+            );
+            let pts = [map2(&c, &f), map2(&h, &f), map2(&[3., 3., 1., 3.], &f)].concat();
+            let mut outer: Vec<u32> = (0..7).collect();
+            if rev {
+                outer.reverse();
+            }
+            let mut m = FacetMesh::new(&pts, &[outer], &[vec![7, 8, 9, 10]], &[]).unwrap();
+            m.validate().unwrap();
+            let n = u.cross(v);
+            assert!(m.normal().dot(n) * if rev { -1.0 } else { 1.0 } > 0.0);
+            assert!(m.is_constrained(0, 1) && m.is_constrained(1, 2) && !m.is_constrained(0, 2));
+            let (mut tr, exact) = (Tracker::new(&m), [5., 1., 6., 2., 1., 6., 2., 5.]);
+            for (k, &q) in map2(&exact, &f).iter().enumerate() {
+                tr.apply(&m.insert(100 + k as u32, q).unwrap(), &m); // exactly on the plane
+            }
+            drive(&mut m, 500, 0.2, 11, |s, t| f(8.0 * s, 8.0 * t)); // a rounding error off it
+            assert!((m.area() - 44.0 * n.length()).abs() < 1e-9 * m.area());
+        }
+    }
+
+    #[test]
+    fn random_insertions_into_square() {
+        let mut m = FacetMesh::new(&xy(&SQUARE), &[vec![0, 1, 2, 3]], &[], &[]).unwrap();
+        drive(&mut m, 500, 0.0, 1, p);
+        let (nv, nb) = (m.num_vertices(), m.constrained_edges().len());
+        assert!(nv > 450 && m.num_triangles() == 2 * nv - nb - 2);
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        for _ in 0..200 {
+            let q = p(rng.gen(), rng.gen());
+            let [a, b, c] = m.locate(q).unwrap().map(|i| m.proj(m.point(i).unwrap()));
+            let q = m.proj(q);
+            let ok = |(x, y): (DVec2, DVec2)| orient2d(x, y, q) >= 0.0;
+            assert!([(a, b), (b, c), (c, a)].into_iter().all(ok));
+        }
+        // many more: stays fast (walk + flips, not O(n) per insertion)
+        let t0 = std::time::Instant::now();
+        for id in 10..20_010 {
+            m.insert(id, p(rng.gen(), rng.gen())).unwrap();
+        }
+        assert!(t0.elapsed().as_secs_f64() < 10.0, "{:?}", t0.elapsed());
+        m.validate().unwrap();
+    }
+
+    #[test]
+    fn grid_20x20_cocircular() {
+        let pts = xy(&SQUARE.map(|c| 19. * c));
+        let mut m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3]], &[], &[]).unwrap();
+        let mut tr = Tracker::new(&m);
+        let mut grid: Vec<u32> = (10..410).collect();
+        let mut rng = ChaCha8Rng::seed_from_u64(2);
+        for i in (1..grid.len()).rev() {
+            grid.swap(i, rng.gen_range(0..=i));
+        }
+        for id in grid {
+            let q = p(((id - 10) % 20) as f64, ((id - 10) / 20) as f64);
+            let ch = match m.insert(id, q) {
+                Ok(ch) => ch,
+                Err(InsertError::OnConstrainedEdge(a, b)) => m.split_edge(a, b, id, q).unwrap(),
+                Err(InsertError::OnVertex(_)) => continue, // a corner
+                Err(e) => panic!("{e}"),
+            };
+            tr.apply(&ch, &m);
+        }
+        m.validate().unwrap();
+        assert_eq!((m.num_vertices(), m.num_triangles()), (400, 2 * 19 * 19));
+        assert_eq!((m.constrained_edges().len(), m.area()), (4 * 19, 361.0));
+    }
+
+    #[test]
+    fn split_boundary_repeatedly_off_the_line() {
+        let [o, u, v] = [[0.1, 0.2, 0.3], [0.7, 0.1, -0.3], [-0.2, 0.9, 0.4]].map(DVec3::from);
+        let f = plane(o, u, v);
+        let pts = map2(&[0., 0., 3., 0., 3., 2., 1., 3., 0., 2.], &f);
+        let mut m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3, 4]], &[], &[]).unwrap();
+        m.validate().unwrap();
+        // split points are not exactly on the segments
+        let off = (1..50).filter(|&k| {
+            let q = pts[0].lerp(pts[1], k as f64 / 50.0);
+            orient2d(m.proj(pts[0]), m.proj(pts[1]), m.proj(q)) != 0.0
+        });
+        assert!(off.count() > 10);
+        let area = m.area();
+        drive(&mut m, 500, 0.8, 9, |s, t| f(3. * s, 3. * t));
+        assert!(m.constrained_edges().len() > 300);
+        assert!((m.area() - area).abs() < 1e-9 * area);
+    }
+
+    #[test]
+    fn refusals_change_nothing() {
+        let pts = xy(&SQUARE_HOLE);
+        let mut m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3]], &[vec![4, 5, 6, 7]], &[]).unwrap();
+        let before = m.triangles();
+        for (q, e) in [
+            (p(5., 1.), InsertError::Outside),
+            (p(500., -1e6), InsertError::Outside),
+            (p(2., 2.), InsertError::Outside),
+            (p(2., 0.), InsertError::OnConstrainedEdge(0, 1)),
+            (p(2., 1.), InsertError::OnConstrainedEdge(4, 5)),
+            (p(4., 4.), InsertError::OnVertex(2)),
+            (p(f64::NAN, 0.5), InsertError::NotFinite),
+        ] {
+            assert_eq!(m.insert(50, q), Err(e));
+        }
+        assert_eq!(m.insert(3, p(0.5, 0.5)), Err(InsertError::IdInUse(3)));
+        for (a, b, id, q, e) in [
+            (0, 2, 50, p(2., 2.), SplitError::NotAnEdge(0, 2)),
+            (0, 1, 50, p(2., 3.5), SplitError::WouldInvert),
+            (0, 1, 1, p(2., 0.), SplitError::IdInUse(1)),
+        ] {
+            assert_eq!(m.split_edge(a, b, id, q), Err(e));
+        }
+        assert_eq!((m.triangles(), m.num_vertices()), (before, 8));
+        m.validate().unwrap();
+        assert_eq!((m.locate(p(2., 2.)), m.locate(p(9., 9.))), (None, None));
+        assert!(m.locate(p(2., 0.)).is_some() && m.locate(p(2., 1.)).is_some());
+    }
+
+    #[test]
+    fn points_and_segments_inside_polygons() {
+        let pts = [
+            0., 0., 1., 0., 1., 1., 0., 1., 0.5, 0., 0.25, 0.5, 0.75, 0.5, 0.5, 0.25, 0.5, 0.75,
+        ];
+        let mut pts = xy(&pts);
+        pts.push(p(0.25, 0.5));
+        // a lone point on a boundary edge splits it
+        let m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3], vec![4]], &[], &[]).unwrap();
+        m.validate().unwrap();
+        assert!(m.is_constrained(0, 4) && m.is_constrained(4, 1) && !m.is_constrained(0, 1));
+        // a dangling segment is an inner subsegment
+        let mut m = FacetMesh::new(&pts, &[vec![0, 1, 2, 3], vec![5, 6]], &[], &[]).unwrap();
+        m.validate().unwrap();
+        assert!(m.is_constrained(5, 6) && m.opposite(5, 6).unwrap().iter().all(|x| x.is_some()));
+        let e = m.insert(20, p(0.5, 0.5));
+        assert_eq!(e, Err(InsertError::OnConstrainedEdge(5, 6)));
+        m.split_edge(5, 6, 20, p(0.5, 0.5)).unwrap();
+        m.validate().unwrap();
+        // errors: crossing segments, coincident vertices, no area, bad id
+        let e = |outer: &[Vec<u32>]| FacetMesh::new(&pts, outer, &[], &[]).unwrap_err();
+        assert!(e(&[vec![0, 1, 2, 3], vec![5, 6], vec![7, 8]]).contains("cross"));
+        assert!(e(&[vec![0, 1, 2, 3], vec![5, 9]]).contains("coincide"));
+        assert!(e(&[vec![0, 1, 4]]).contains("area"));
+        assert!(e(&[vec![0, 1, 99]]).contains("range"));
+    }
+
+    /// Random star-shaped polygons (some with integer, collinear vertices) with a square hole,
+    /// on randomly rotated planes (coordinates rounded: not exactly coplanar).
+    #[test]
+    fn random_polygons_on_rotated_planes() {
+        for seed in 0..12u64 {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            let axis = DVec3::new(rng.gen(), rng.gen(), rng.gen::<f64>() + 0.1).normalize();
+            let q = glam::DQuat::from_axis_angle(axis, rng.gen_range(0.0..6.0));
+            let f = move |s: f64, t: f64| q * DVec3::new(s, t, 0.0) + DVec3::new(0.1, 2.3, -0.7);
+            let n = rng.gen_range(3..60);
+            let round = |x: f64| if seed % 2 == 0 { x.round() } else { x };
+            let mut st: Vec<(f64, f64)> = (0..n)
+                .map(|i| {
+                    let (a, r) = (
+                        i as f64 / n as f64 * std::f64::consts::TAU,
+                        rng.gen_range(3.0..5.0),
+                    );
+                    (round(a.cos() * r), round(a.sin() * r))
+                })
+                .collect();
+            st.dedup();
+            while st.len() > 1 && st.first() == st.last() {
+                st.pop();
+            }
+            let k = st.len() as u32;
+            st.extend([(-1., -1.), (1., -1.), (1., 1.), (-1., 1.)]);
+            let pts: Vec<DVec3> = st.iter().map(|&(s, t)| f(s, t)).collect();
+            let hole = vec![k, k + 1, k + 2, k + 3];
+            let mut m = FacetMesh::new(&pts, &[(0..k).collect()], &[hole], &[]).unwrap();
+            m.validate().unwrap();
+            let g = |s: f64, t: f64| f(10. * s - 5., 10. * t - 5.);
+            drive(&mut m, 800, 0.25, seed, g);
+        }
+    }
 }

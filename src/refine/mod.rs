@@ -191,6 +191,10 @@ impl std::fmt::Display for MeshError {
 }
 impl std::error::Error for MeshError {}
 
+/// Refinement passes at most (each re-marks regions and re-checks every tet; the second pass
+/// almost always finds nothing to do).
+const MAX_PASSES: usize = 4;
+
 /// Progress callback: (fraction done estimate in [0, 1], current vertex count) -> keep going?
 pub type Progress<'a> = &'a mut dyn FnMut(f64, usize) -> bool;
 
@@ -208,7 +212,7 @@ pub fn mesh(
     let mut dom = domain::Domain::new(input)?;
     let mut budget = recover::MAX_RECOVERY_SPLITS.min(params.max_vertices.saturating_mul(4));
     dom.recover_boundary(&mut budget)?;
-    let regions = dom.mark_domain(input)?;
+    let mut regions = dom.mark_domain(input)?;
     let seconds_recovery = start.elapsed().as_secs_f64();
     let auto;
     let spacing: &dyn Spacing = match spacing {
@@ -228,11 +232,22 @@ pub fn mesh(
         };
         let max_v = params.max_vertices.max(1) as f64;
         let mut on_step = |n: usize| progress((n as f64 / max_v).min(1.0), n);
-        dom.created_log.clear();
-        let mut r = quality::Refiner::new(&mut dom, params, spacing, &regions);
-        r.run(&mut on_step)?;
-        gave_up = r.gave_up;
-        stop_reason = r.stop_reason.take();
+        for _pass in 0..MAX_PASSES {
+            let before = dom.dt.num_vertices();
+            dom.created_log.clear();
+            let mut r = quality::Refiner::new(&mut dom, params, spacing, &regions);
+            r.run(&mut on_step)?;
+            gave_up = r.gave_up;
+            stop_reason = r.stop_reason.take();
+            // A boundary split can delete a subfacet of another facet for a moment, letting
+            // region labels leak across it: check the whole boundary, re-mark from the seeds
+            // and look at every tet again until a pass changes nothing.
+            dom.recover_boundary(&mut budget)?;
+            regions = dom.mark_domain(input)?;
+            if stop_reason.is_some() || dom.dt.num_vertices() == before {
+                break;
+            }
+        }
     }
     let seconds_refinement = start.elapsed().as_secs_f64() - seconds_recovery;
     let mesh = dom.to_mesh(&regions);

@@ -5,16 +5,16 @@
 //! circumcentre encroaches a subsegment or subfacet, that boundary element is split from its
 //! own picking interval or disk instead.
 
-use super::domain::{seg_key, tri_key, Domain};
+use super::domain::{seg_key, tri_key, Domain, VertexKind};
 use super::mark::Regions;
 use super::{MeshError, Params, Spacing};
 use crate::delaunay::{tables::FACE, DryRun, INFINITE};
-use crate::geom::{diametric_ball, equatorial_ball, tri_circumcenter, TetQuality};
+use crate::geom::{diametric_ball, equatorial_ball, tri_circumcenter};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::cmp::Ordering;
-use std::collections::BinaryHeap;
+use std::collections::VecDeque;
 
 /// Badness classes, in refinement priority order.
 const SIZE: u8 = 2;
@@ -61,11 +61,14 @@ pub struct Refiner<'a> {
     pub spacing: &'a dyn Spacing,
     pub regions: &'a Regions,
     rng: ChaCha8Rng,
-    heap: BinaryHeap<Bad>,
+    /// One FIFO queue per badness class; the highest class is served first.
+    queues: [VecDeque<Bad>; 3],
     /// Bad tets left alone because fixing them needed an ever smaller boundary split (the
     /// signature of an acute input angle).
     pub gave_up: usize,
     pub stop_reason: Option<String>,
+    /// cos(params.min_dihedral): a tet whose largest dihedral cosine exceeds it is a sliver.
+    cos_min_dihedral: f64,
 }
 
 impl<'a> Refiner<'a> {
@@ -81,9 +84,10 @@ impl<'a> Refiner<'a> {
             params,
             spacing,
             regions,
-            heap: BinaryHeap::new(),
+            queues: Default::default(),
             gave_up: 0,
             stop_reason: None,
+            cos_min_dihedral: params.min_dihedral.to_radians().cos(),
         }
     }
 
@@ -106,19 +110,8 @@ impl<'a> Refiner<'a> {
             return Ok(None);
         }
         let [a, b, c, d] = self.dom.dt.tet_points(t);
-        let q = TetQuality::of(a, b, c, d);
+        let s = Shape::of(a, b, c, d);
         let verts = self.dom.dt.tet(t);
-        let Some(centre) = q.circumcenter else {
-            return Ok(Some(Bad {
-                class: SLIVER,
-                badness: f64::INFINITY,
-                tet: t,
-                verts,
-            }));
-        };
-        let f = self.spacing_at(centre, tag)?;
-        let xi = q.circumradius / f;
-        let p = self.params;
         let bad = |class, badness| {
             Some(Bad {
                 class,
@@ -127,12 +120,17 @@ impl<'a> Refiner<'a> {
                 verts,
             })
         };
-        Ok(if xi > p.size_factor {
+        let Some(centre) = s.circumcenter else {
+            return Ok(bad(SLIVER, f64::INFINITY));
+        };
+        let xi = s.circumradius / self.spacing_at(centre, tag)?;
+        let rho = s.circumradius / s.shortest_edge;
+        Ok(if xi > self.params.size_factor {
             bad(SIZE, xi)
-        } else if q.rho > p.rho0 {
-            bad(RATIO, q.rho)
-        } else if q.sigma < p.sigma0 || q.min_dihedral < p.min_dihedral {
-            bad(SLIVER, 1.0 / q.min_dihedral.max(1e-300))
+        } else if rho > self.params.rho0 {
+            bad(RATIO, rho)
+        } else if self.is_sliver(&s) {
+            bad(SLIVER, s.max_cos_dihedral)
         } else {
             None
         })
@@ -147,10 +145,14 @@ impl<'a> Refiner<'a> {
     fn push_tets(&mut self, tets: &[u32]) -> Result<(), MeshError> {
         for &t in tets {
             if let Some(b) = self.classify(t)? {
-                self.heap.push(b);
+                self.queues[b.class as usize].push_back(b);
             }
         }
         Ok(())
+    }
+
+    fn next_bad(&mut self) -> Option<Bad> {
+        self.queues.iter_mut().rev().find_map(|q| q.pop_front())
     }
 
     /// Runs the refinement until no bad tet is left or a budget stops it.
@@ -158,7 +160,7 @@ impl<'a> Refiner<'a> {
         let all: Vec<u32> = self.dom.dt.finite_tet_ids().collect();
         self.push_tets(&all)?;
         let mut steps = 0usize;
-        while let Some(bad) = self.heap.pop() {
+        while let Some(bad) = self.next_bad() {
             if !self.dom.dt.is_alive(bad.tet) || self.dom.dt.tet(bad.tet) != bad.verts {
                 continue;
             }
@@ -173,9 +175,6 @@ impl<'a> Refiner<'a> {
             if steps % 1024 == 0 && !progress(self.dom.dt.num_vertices()) {
                 return Err(MeshError::Cancelled);
             }
-            if std::env::var("SM_DEBUG").is_ok() && bad.class == SLIVER {
-                eprintln!("sliver pop tet {} badness {}", bad.tet, bad.badness);
-            }
             let gave_up = self.gave_up;
             self.refine_tet(bad)?;
             // A boundary split need not destroy the tet that asked for it: look again.
@@ -186,34 +185,12 @@ impl<'a> Refiner<'a> {
                 self.push_tets(&[bad.tet])?;
             }
         }
-        if std::env::var("SM_DEBUG").is_ok() {
-            let mut counts = [0; 3];
-            let ids: Vec<u32> = self.dom.dt.finite_tet_ids().collect();
-            for t in ids {
-                if let Some(b) = self.classify(t)? {
-                    counts[b.class as usize] += 1;
-                    let q = {
-                        let [a, b2, c, d] = self.dom.dt.tet_points(t);
-                        TetQuality::of(a, b2, c, d)
-                    };
-                    eprintln!(
-                        "left: tet {t} {:?} class {} rho {} sigma {} tag {}",
-                        b.verts,
-                        b.class,
-                        q.rho,
-                        q.sigma,
-                        self.dom.dt.tag(t)
-                    );
-                }
-            }
-            eprintln!("steps {steps} remaining bad by class {counts:?}");
-        }
         Ok(())
     }
 
     fn refine_tet(&mut self, bad: Bad) -> Result<(), MeshError> {
         let [a, b, c, d] = self.dom.dt.tet_points(bad.tet);
-        let q = TetQuality::of(a, b, c, d);
+        let q = Shape::of(a, b, c, d);
         let Some(centre) = q.circumcenter else {
             self.gave_up += 1;
             return Ok(());
@@ -221,7 +198,10 @@ impl<'a> Refiner<'a> {
         let r = q.circumradius;
         if let Some(bnd) = self.encroached_boundary(centre, Some(bad.tet)) {
             let rb = self.boundary_radius(bnd);
-            if bad.class != SIZE && rb < 0.25 * r {
+            // Without small input angles an encroached boundary element has R >= R_tau / 2
+            // (the paper, section 2.4); a much smaller one means splitting it would start a
+            // cascade of ever smaller splits (an acute angle nearby).
+            if rb < 0.25 * r && !self.resettle_near(bad.tet)? {
                 self.gave_up += 1;
                 return Ok(());
             }
@@ -282,12 +262,12 @@ impl<'a> Refiner<'a> {
         hint: Option<u32>,
         allowed: Option<Boundary>,
     ) -> Option<(usize, f64)> {
-        if allowed.is_none() && self.encroached_boundary(p, hint).is_some() {
-            return None;
-        }
-        let DryRun::Cavity { faces, .. } = self.dom.dt.dry_run(p, hint) else {
+        let DryRun::Cavity { removed, faces } = self.dom.dt.dry_run(p, hint) else {
             return None;
         };
+        if allowed.is_none() && self.boundary_in_cavity(p, &removed).is_some() {
+            return None;
+        }
         let mut n = 0;
         let mut worst = f64::INFINITY;
         for f in faces {
@@ -295,14 +275,17 @@ impl<'a> Refiner<'a> {
                 continue;
             }
             let [x, y, z] = f.map(|v| self.dom.point(v));
-            let q = TetQuality::of(x, y, z, p);
-            let sliver = q.sigma < self.params.sigma0 || q.min_dihedral < self.params.min_dihedral;
-            if q.circumradius <= self.params.b * r && sliver {
+            let s = Shape::of(x, y, z, p);
+            if s.circumradius <= self.params.b * r && self.is_sliver(&s) {
                 n += 1;
-                worst = worst.min(q.min_dihedral);
+                worst = worst.min(s.max_cos_dihedral.mul_add(-1.0, 1.0));
             }
         }
         Some((n, worst))
+    }
+
+    fn is_sliver(&self, s: &Shape) -> bool {
+        s.sigma < self.params.sigma0 || s.max_cos_dihedral > self.cos_min_dihedral
     }
 
     /// The boundary element whose protection inserting `p` would violate: a subsegment or
@@ -313,29 +296,52 @@ impl<'a> Refiner<'a> {
         let DryRun::Cavity { removed, .. } = self.dom.dt.dry_run(p, hint) else {
             return None;
         };
+        self.boundary_in_cavity(p, &removed)
+    }
+
+    /// See [`Self::encroached_boundary`]; `removed` is the cavity of `p`.
+    fn boundary_in_cavity(&self, p: DVec3, removed: &[u32]) -> Option<Boundary> {
         let dom = &*self.dom;
         let mut crosses = false;
         let mut crossed: Option<Boundary> = None;
         let mut segs = vec![];
         let mut facets = vec![];
-        for &t in &removed {
+        // The cavity and the ring of tets around it: an equatorial ball can hold p while the
+        // (obtuse) tet on its inner side does not have p in its circumsphere.
+        let mut near: Vec<u32> = removed.to_vec();
+        for &t in removed {
+            for n in dom.dt.neighbors(t) {
+                if !removed.contains(&n) && !near.contains(&n) {
+                    near.push(n);
+                }
+            }
+        }
+        for (k, &t) in near.iter().enumerate() {
+            let in_cavity = k < removed.len();
             if !dom.dt.is_finite(t) || dom.dt.tag(t) == 0 {
-                crosses = true;
+                crosses |= in_cavity;
                 continue;
             }
             let v = dom.dt.tet(t);
+            let on_boundary = v.map(|x| dom.kind[x as usize] != VertexKind::Volume);
+            if on_boundary.iter().filter(|&&b| b).count() < 2 {
+                continue; // no subsegment or subfacet among its edges and faces
+            }
             for i in 0..4 {
                 for j in i + 1..4 {
                     let k = seg_key(v[i], v[j]);
-                    if dom.subsegs.contains_key(&k) {
+                    if on_boundary[i] && on_boundary[j] && dom.subsegs.contains_key(&k) {
                         segs.push(k);
                     }
+                }
+                if on_boundary[i] {
+                    continue; // face i is opposite vertex i: it holds the other three
                 }
                 let f = FACE[i].map(|l| v[l]);
                 if let Some(&fi) = dom.subfacets.get(&tri_key(f)) {
                     facets.push((fi, tri_key(f)));
                     let n = dom.dt.neighbors(t)[i];
-                    if removed.contains(&n) {
+                    if in_cavity && removed.contains(&n) {
                         crosses = true;
                         crossed = Some(Boundary::Facet(fi, tri_key(f)));
                     }
@@ -364,6 +370,36 @@ impl<'a> Refiner<'a> {
             return crossed.or_else(|| facets.first().map(|&(fi, t)| Boundary::Facet(fi, t)));
         }
         None
+    }
+
+    /// Queues the subsegments and subfacets around tet `t` and restores empty encroachment
+    /// there. Returns whether anything was split (a vertex of `t` may be the encroacher that
+    /// made it hug the boundary).
+    fn resettle_near(&mut self, t: u32) -> Result<bool, MeshError> {
+        let n_before = self.dom.dt.num_vertices();
+        let mut near = vec![t];
+        near.extend(self.dom.dt.neighbors(t));
+        for u in near {
+            if !self.dom.dt.is_finite(u) {
+                continue;
+            }
+            let v = self.dom.dt.tet(u);
+            for i in 0..4 {
+                for j in i + 1..4 {
+                    let k = seg_key(v[i], v[j]);
+                    if self.dom.subsegs.contains_key(&k) {
+                        self.dom.dirty_segs.push(k);
+                    }
+                }
+                let f = tri_key(FACE[i].map(|l| v[l]));
+                if self.dom.subfacets.contains_key(&f) {
+                    self.dom.dirty_tris.push(f);
+                }
+            }
+        }
+        self.settle_boundary()?;
+        self.push_recent()?;
+        Ok(self.dom.dt.num_vertices() > n_before)
     }
 
     fn boundary_radius(&self, b: Boundary) -> f64 {
@@ -470,5 +506,97 @@ impl<'a> Refiner<'a> {
     fn settle_boundary(&mut self) -> Result<(), MeshError> {
         let mut budget = super::recover::MAX_RECOVERY_SPLITS;
         self.dom.settle(&mut budget)
+    }
+}
+
+/// The measures refinement decides on, computed without trigonometry.
+#[derive(Debug, Clone, Copy)]
+struct Shape {
+    circumcenter: Option<DVec3>,
+    circumradius: f64,
+    shortest_edge: f64,
+    sigma: f64,
+    /// Cosine of the smallest dihedral angle.
+    max_cos_dihedral: f64,
+}
+
+impl Shape {
+    #[inline]
+    fn of(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Shape {
+        let sphere = crate::geom::circumsphere(a, b, c, d);
+        let l2 = [
+            a.distance_squared(b),
+            a.distance_squared(c),
+            a.distance_squared(d),
+            b.distance_squared(c),
+            b.distance_squared(d),
+            c.distance_squared(d),
+        ]
+        .into_iter()
+        .fold(f64::INFINITY, f64::min);
+        let shortest_edge = l2.sqrt();
+        let volume = (b - a).dot((c - a).cross(d - a)).abs() / 6.0;
+        // Face normals, all outward or all inward (the sign cancels): the dihedral angle at an
+        // edge is pi minus the angle between its two faces' normals, so its cosine is
+        // -n_i . n_j / (|n_i| |n_j|).
+        let n = [
+            (d - b).cross(c - b),
+            (c - a).cross(d - a),
+            (d - a).cross(b - a),
+            (b - a).cross(c - a),
+        ];
+        let len = n.map(|v| v.length());
+        let mut max_cos = -1.0f64;
+        for i in 0..4 {
+            for j in i + 1..4 {
+                let cos = -n[i].dot(n[j]) / (len[i] * len[j]);
+                max_cos = max_cos.max(cos);
+            }
+        }
+        Shape {
+            circumcenter: sphere.map(|s| s.0),
+            circumradius: sphere.map_or(f64::INFINITY, |s| s.1),
+            shortest_edge,
+            sigma: volume / (l2 * shortest_edge),
+            max_cos_dihedral: if max_cos.is_nan() { 1.0 } else { max_cos },
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::TetQuality;
+
+    #[test]
+    fn shape_agrees_with_tet_quality() {
+        let tets = [
+            [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z],
+            [
+                DVec3::new(0.1, 0.2, 0.0),
+                DVec3::new(1.0, 0.1, 0.05),
+                DVec3::new(0.4, 0.9, 0.1),
+                DVec3::new(0.5, 0.4, 0.03),
+            ],
+            [
+                DVec3::new(0.0, 0.0, 0.0),
+                DVec3::new(1.0, 0.0, 0.0),
+                DVec3::new(0.5, 0.866, 0.0),
+                DVec3::new(0.5, 0.3, 0.8),
+            ],
+        ];
+        for t in tets {
+            for flip in [false, true] {
+                let [a, mut b, mut c, d] = t;
+                if flip {
+                    std::mem::swap(&mut b, &mut c);
+                }
+                let s = Shape::of(a, b, c, d);
+                let q = TetQuality::of(a, b, c, d);
+                assert!((s.max_cos_dihedral - q.min_dihedral.to_radians().cos()).abs() < 1e-12);
+                assert!((s.sigma - q.sigma).abs() < 1e-12 * q.sigma.max(1.0));
+                assert!((s.circumradius - q.circumradius).abs() < 1e-12);
+            }
+        }
     }
 }

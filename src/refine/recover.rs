@@ -37,9 +37,14 @@ impl Domain {
 
     /// Queues the subsegments and subfacets among the edges and faces of the tets the last
     /// insertion created: the new vertex may encroach them.
+    /// Also queues those among the deleted tets' edges and faces: an insertion on one facet
+    /// may remove a subfacet of another, which must then be recovered.
     pub fn queue_around_last_insertion(&mut self) {
-        for &t in self.dt.last_created() {
-            let v = self.dt.tet(t);
+        let created = self.dt.last_created().iter().map(|&t| self.dt.tet(t));
+        let quads: Vec<[u32; 4]> = created
+            .chain(self.dt.last_removed().iter().copied())
+            .collect();
+        for v in quads {
             for i in 0..4 {
                 for j in i + 1..4 {
                     let k = seg_key(v[i], v[j]);
@@ -81,11 +86,6 @@ impl Domain {
                 _ => self.split_subfacet(f, tri, budget)?,
             }
         }
-    }
-
-    /// Whether subsegment ab is an unencroached edge of the triangulation.
-    pub fn segment_ok(&self, a: u32, b: u32) -> bool {
-        self.subsegment_status(a, b) == Status::Ok
     }
 
     /// A subsegment is fine when it is an edge of the triangulation and no vertex of a tet
@@ -208,12 +208,15 @@ impl Domain {
         Ok(())
     }
 
-    /// Subsegments of facet `f` whose closed diametric ball contains `p`.
+    /// Subsegments of facet `f` whose closed diametric ball contains `p` (up to rounding).
     pub fn facet_subsegments_encroached_by(&self, f: u32, p: DVec3) -> Vec<(u32, u32)> {
         let mut out = vec![];
         for [x, y] in self.facets[f as usize].constrained_edges() {
             let (c, r) = diametric_ball(self.point(x), self.point(y));
-            if p.distance_squared(c) <= r * r {
+            // Slightly inflated: a rounded circumcentre meant to lie on the subsegment (the
+            // hypotenuse of a right subfacet) must count as encroaching it, or it would be
+            // inserted into the facet a rounding error away from the segment.
+            if p.distance_squared(c) <= r * r * (1.0 + 1e-9) {
                 out.push(seg_key(x, y));
             }
         }

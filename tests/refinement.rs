@@ -1,0 +1,178 @@
+//! Quality refinement (issue 4) on the acute-free models: every tet meets the bounds, the
+//! boundary still conforms, the volume is preserved, the mesh is still Delaunay; size
+//! conformity with a graded spacing; determinism.
+
+mod common;
+use common::*;
+use slivermesh::geom::TetQuality;
+use slivermesh::refine::{mesh, ConstantSpacing, FnSpacing, Params, Spacing};
+use slivermesh::{DVec3, TetMesh};
+
+const ACUTE_FREE: &[(&str, Option<f64>)] = &[
+    ("poly/cube.poly", Some(1.0)),
+    ("poly/lshape.poly", Some(3.0)),
+    ("poly/stairs.poly", Some(20.0)),
+    ("poly/box_with_cavity.poly", Some(63.0)),
+    ("poly/two_materials.poly", Some(2.0)),
+    ("poly/drilled_block.poly", Some(8.0)),
+    ("poly/thin_plate.poly", Some(50.0)),
+    ("poly/tetgen_example.poly", Some(17.9375)),
+    ("off/cube.off", Some(8.0)),
+    ("off/cross.off", None),
+];
+
+fn check_quality(rel: &str, m: &TetMesh, params: &Params) {
+    for (i, t) in m.tets.iter().enumerate() {
+        let [a, b, c, d] = t.map(|v| m.vertices[v as usize]);
+        let q = TetQuality::of(a, b, c, d);
+        assert!(q.rho <= params.rho0 + 1e-12, "{rel}: tet {i} rho {}", q.rho);
+        assert!(q.sigma >= params.sigma0, "{rel}: tet {i} sigma {}", q.sigma);
+        assert!(
+            q.min_dihedral >= params.min_dihedral - 1e-9,
+            "{rel}: tet {i} min dihedral {}",
+            q.min_dihedral
+        );
+    }
+}
+
+fn refined(
+    rel: &str,
+    volume: Option<f64>,
+    params: &Params,
+    spacing: Option<&dyn Spacing>,
+) -> TetMesh {
+    let input = read_model(rel);
+    let (m, report) = mesh(&input, params, spacing, None).unwrap_or_else(|e| panic!("{rel}: {e}"));
+    assert!(report.complete, "{rel}: {:?}", report.stop_reason);
+    check_orientation(&m);
+    check_delaunay(&m);
+    check_boundary_faces_are_tet_faces(&m);
+    let want = facet_area_by_marker(&input);
+    let got = boundary_area_by_marker(&m);
+    for (mk, a) in &want {
+        let g = got.get(mk).copied().unwrap_or(0.0);
+        assert!(
+            rel_close(g, *a, 1e-9),
+            "{rel}: marker {mk}: boundary area {g}, facets {a}"
+        );
+    }
+    if let Some(v) = volume {
+        let vol = total_volume(&m);
+        assert!(rel_close(vol, v, 1e-9), "{rel}: volume {vol}, expected {v}");
+    }
+    check_quality(rel, &m, params);
+    m
+}
+
+#[test]
+fn acute_free_models_meet_every_bound_with_default_spacing() {
+    let params = Params::default();
+    for &(rel, vol) in ACUTE_FREE {
+        refined(rel, vol, &params, None);
+    }
+}
+
+#[test]
+fn acute_free_models_meet_every_bound_with_a_fine_constant_spacing() {
+    let params = Params::default();
+    for &(rel, vol) in &ACUTE_FREE[..3] {
+        refined(rel, vol, &params, Some(&ConstantSpacing(0.15)));
+    }
+}
+
+#[test]
+fn two_materials_keeps_region_volumes_after_refinement() {
+    let m = refined(
+        "poly/two_materials.poly",
+        Some(2.0),
+        &Params::default(),
+        Some(&ConstantSpacing(0.2)),
+    );
+    assert!(rel_close(region_volume(&m, 1), 1.0, 1e-9));
+    assert!(rel_close(region_volume(&m, 2), 1.0, 1e-9));
+}
+
+#[test]
+fn graded_spacing_is_respected() {
+    let x0 = DVec3::new(0.0, 0.0, 0.0);
+    let f = FnSpacing(move |p: DVec3| 0.05 + 0.2 * p.distance(x0));
+    let params = Params::default();
+    let m = refined("poly/cube.poly", Some(1.0), &params, Some(&f));
+    let mut min_ratio = f64::INFINITY;
+    let mut max_ratio: f64 = 0.0;
+    for t in &m.tets {
+        let [a, b, c, d] = t.map(|v| m.vertices[v as usize]);
+        let q = TetQuality::of(a, b, c, d);
+        let centre = q.circumcenter.unwrap();
+        assert!(q.circumradius / f.at(centre) <= params.size_factor * (1.0 + 1e-9));
+        for (x, y) in [(a, b), (a, c), (a, d), (b, c), (b, d), (c, d)] {
+            let r = x.distance(y) / f.at((x + y) * 0.5);
+            min_ratio = min_ratio.min(r);
+            max_ratio = max_ratio.max(r);
+        }
+    }
+    // Edge length / f at the midpoint: measured band (see docs/parameters.md).
+    assert!(max_ratio <= 2.0, "max edge/f {max_ratio}");
+    assert!(min_ratio >= 0.2, "min edge/f {min_ratio}");
+    // Graded: small tets near x0, large ones far away.
+    let near = m
+        .tets
+        .iter()
+        .filter(|t| m.vertices[t[0] as usize].length() < 0.2)
+        .count();
+    assert!(near > 20, "refined near x0: {near}");
+}
+
+#[test]
+fn same_seed_same_mesh_and_other_seed_other_mesh() {
+    let input = read_model("poly/lshape.poly");
+    let params = Params::default();
+    let h = ConstantSpacing(0.3);
+    let (a, _) = mesh(&input, &params, Some(&h), None).unwrap();
+    let (b, _) = mesh(&input, &params, Some(&h), None).unwrap();
+    assert_eq!(a, b);
+    let other = Params { seed: 99, ..params };
+    let (c, _) = mesh(&input, &other, Some(&h), None).unwrap();
+    assert_ne!(a, c);
+}
+
+#[test]
+fn bad_spacing_is_an_error_naming_the_point() {
+    let input = read_model("poly/cube.poly");
+    let f = FnSpacing(|p: DVec3| if p.x > 0.5 { f64::NAN } else { 0.3 });
+    let err = mesh(&input, &Params::default(), Some(&f), None).unwrap_err();
+    let msg = err.to_string();
+    assert!(msg.contains("NaN") && msg.contains("spacing"), "{msg}");
+    let zero = FnSpacing(|_| 0.0);
+    assert!(mesh(&input, &Params::default(), Some(&zero), None).is_err());
+}
+
+#[test]
+fn vertex_budget_stops_with_a_reason() {
+    let input = read_model("poly/cube.poly");
+    let params = Params {
+        max_vertices: 200,
+        ..Params::default()
+    };
+    let (_, report) = mesh(&input, &params, Some(&ConstantSpacing(0.05)), None).unwrap();
+    assert!(!report.complete);
+    assert!(report.stop_reason.unwrap().contains("max_vertices"));
+}
+
+#[test]
+fn progress_callback_can_cancel() {
+    let input = read_model("poly/cube.poly");
+    let mut calls = 0;
+    let mut cb = |_: f64, _: usize| {
+        calls += 1;
+        false
+    };
+    let r = mesh(
+        &input,
+        &Params::default(),
+        Some(&ConstantSpacing(0.03)),
+        Some(&mut cb),
+    );
+    assert!(matches!(r, Err(slivermesh::refine::MeshError::Cancelled)));
+    assert!(calls >= 1);
+}
