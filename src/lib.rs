@@ -5,7 +5,9 @@
 //! → `refine` (Li's REMOVE-SLIVER) → `delaunay` (3D kernel) → `geom` (exact predicates, measures).
 //! `mesh` holds the output model shared by writers and meshers. See ARCHITECTURE.md.
 
+pub mod api;
 pub mod delaunay;
+pub mod ffi;
 pub mod geom;
 pub mod io;
 pub mod mesh;

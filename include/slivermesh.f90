@@ -1,0 +1,367 @@
+!> slivermesh: Fortran 2008 interface (ISO_C_BINDING) to the C ABI of include/slivermesh.h.
+!>
+!> Compile this file with your program (it defines module `slivermesh`) and link libslivermesh:
+!>     gfortran -c slivermesh.f90 && gfortran my_code.f90 slivermesh.o -lslivermesh
+!> With CMake: find_package(SliverMesh CONFIG) gives ${SliverMesh_FORTRAN_MODULE} (this file).
+!>
+!> Conventions (see slivermesh.h for each function):
+!>  - The handle is a type(c_ptr) from sm_create(); free it with sm_destroy().
+!>  - Every fallible function returns an integer(c_int32_t) status: SM_OK (0) or SM_ERR_*;
+!>    sm_last_error(m) then returns the message as a Fortran string.
+!>  - Vertex ids are 0-BASED (C convention): subtract 1 from Fortran indices. They are uint32_t in
+!>    C, passed here as integer(c_int32_t) (ids below 2**31).
+!>  - Coordinates are real(c_double) arrays xyz(3, n); counts are integer(c_size_t).
+!>  - Outputs are copied into arrays you allocate after asking for the count (sm_num_*).
+!>  - Callbacks are bind(C) procedures passed with c_funloc(); user data with c_loc() or
+!>    c_null_ptr. See examples/fortran/cube.f90.
+!>  - Functions taking a string (sm_set_param, sm_get_param, sm_write) have Fortran wrappers
+!>    that add the terminating NUL; the raw bind(C) ones are *_c.
+module slivermesh
+  use, intrinsic :: iso_c_binding, only: c_ptr, c_funptr, c_null_ptr, c_null_char, c_char, &
+                                         c_double, c_int32_t, c_size_t, c_associated, c_f_pointer
+  implicit none
+  private
+
+  ! Status codes (never renumbered).
+  integer(c_int32_t), parameter, public :: SM_OK = 0
+  integer(c_int32_t), parameter, public :: SM_ERR_NULL = 1
+  integer(c_int32_t), parameter, public :: SM_ERR_INVALID_ARGUMENT = 2
+  integer(c_int32_t), parameter, public :: SM_ERR_INVALID_INPUT = 3
+  integer(c_int32_t), parameter, public :: SM_ERR_SPACING = 4
+  integer(c_int32_t), parameter, public :: SM_ERR_CANCELLED = 5
+  integer(c_int32_t), parameter, public :: SM_ERR_BUFFER_TOO_SMALL = 6
+  integer(c_int32_t), parameter, public :: SM_ERR_NOT_REFINED = 7
+  integer(c_int32_t), parameter, public :: SM_ERR_IO = 8
+  integer(c_int32_t), parameter, public :: SM_ERR_PANIC = 9
+  integer(c_int32_t), parameter, public :: SM_ERR_POISONED = 10
+  integer(c_int32_t), parameter, public :: SM_ERR_INTERNAL = 11
+  integer(c_int32_t), parameter, public :: SM_ERR_BUSY = 12
+
+  !> The last run's figures (struct sm_quality).
+  type, bind(C), public :: sm_quality
+    integer(c_size_t) :: n_vertices, n_tets, n_boundary_faces
+    real(c_double) :: seconds_recovery, seconds_refinement, seconds_total
+    real(c_double) :: max_rho, min_sigma, min_dihedral_deg, max_dihedral_deg
+    integer(c_size_t) :: tets_below_deg(4)
+    real(c_double) :: max_size_ratio, edge_ratio_min, edge_ratio_median, edge_ratio_max
+    integer(c_size_t) :: n_acute_angles, n_bad_near_acute
+    integer(c_int32_t) :: complete
+  end type sm_quality
+
+  !> Shapes of the callbacks (declare yours like these, with bind(C), and pass c_funloc(f)).
+  abstract interface
+    !> Target element size at (x, y, z): finite and > 0, anything else fails sm_refine.
+    function sm_spacing_fn(x, y, z, user_data) bind(C) result(h)
+      import :: c_double, c_ptr
+      real(c_double), value :: x, y, z
+      type(c_ptr), value :: user_data
+      real(c_double) :: h
+    end function sm_spacing_fn
+    !> Batched: out(i) = size at xyz(:, i), i = 1..n.
+    subroutine sm_spacing_batch_fn(n, xyz, out, user_data) bind(C)
+      import :: c_double, c_ptr, c_size_t
+      integer(c_size_t), value :: n
+      real(c_double), intent(in) :: xyz(3, n)
+      real(c_double), intent(out) :: out(n)
+      type(c_ptr), value :: user_data
+    end subroutine sm_spacing_batch_fn
+    !> Progress: return non-zero to cancel sm_refine.
+    function sm_progress_fn(fraction, n_vertices, user_data) bind(C) result(stop)
+      import :: c_double, c_size_t, c_ptr, c_int32_t
+      real(c_double), value :: fraction
+      integer(c_size_t), value :: n_vertices
+      type(c_ptr), value :: user_data
+      integer(c_int32_t) :: stop
+    end function sm_progress_fn
+  end interface
+  public :: sm_spacing_fn, sm_spacing_batch_fn, sm_progress_fn
+
+  interface
+    function sm_create() bind(C, name="sm_create") result(m)
+      import :: c_ptr
+      type(c_ptr) :: m
+    end function sm_create
+
+    subroutine sm_destroy(m) bind(C, name="sm_destroy")
+      import :: c_ptr
+      type(c_ptr), value :: m
+    end subroutine sm_destroy
+
+    function sm_add_vertices(m, xyz, n) bind(C, name="sm_add_vertices") result(s)
+      import :: c_ptr, c_double, c_size_t, c_int32_t
+      type(c_ptr), value :: m
+      real(c_double), intent(in) :: xyz(*)
+      integer(c_size_t), value :: n
+      integer(c_int32_t) :: s
+    end function sm_add_vertices
+
+    function sm_add_facet(m, ids, n, marker) bind(C, name="sm_add_facet") result(s)
+      import :: c_ptr, c_size_t, c_int32_t
+      type(c_ptr), value :: m
+      integer(c_int32_t), intent(in) :: ids(*)
+      integer(c_size_t), value :: n
+      integer(c_int32_t), value :: marker
+      integer(c_int32_t) :: s
+    end function sm_add_facet
+
+    function sm_add_facet_hole(m, ids, n) bind(C, name="sm_add_facet_hole") result(s)
+      import :: c_ptr, c_size_t, c_int32_t
+      type(c_ptr), value :: m
+      integer(c_int32_t), intent(in) :: ids(*)
+      integer(c_size_t), value :: n
+      integer(c_int32_t) :: s
+    end function sm_add_facet_hole
+
+    function sm_add_hole(m, x, y, z) bind(C, name="sm_add_hole") result(s)
+      import :: c_ptr, c_double, c_int32_t
+      type(c_ptr), value :: m
+      real(c_double), value :: x, y, z
+      integer(c_int32_t) :: s
+    end function sm_add_hole
+
+    function sm_add_region(m, x, y, z, attribute, max_size) bind(C, name="sm_add_region") &
+        result(s)
+      import :: c_ptr, c_double, c_int32_t
+      type(c_ptr), value :: m
+      real(c_double), value :: x, y, z
+      integer(c_int32_t), value :: attribute
+      real(c_double), value :: max_size
+      integer(c_int32_t) :: s
+    end function sm_add_region
+
+    function sm_set_spacing_cb(m, f, user_data) bind(C, name="sm_set_spacing_cb") result(s)
+      import :: c_ptr, c_funptr, c_int32_t
+      type(c_ptr), value :: m
+      type(c_funptr), value :: f
+      type(c_ptr), value :: user_data
+      integer(c_int32_t) :: s
+    end function sm_set_spacing_cb
+
+    function sm_set_spacing_batch_cb(m, f, user_data) bind(C, name="sm_set_spacing_batch_cb") &
+        result(s)
+      import :: c_ptr, c_funptr, c_int32_t
+      type(c_ptr), value :: m
+      type(c_funptr), value :: f
+      type(c_ptr), value :: user_data
+      integer(c_int32_t) :: s
+    end function sm_set_spacing_batch_cb
+
+    function sm_set_spacing_const(m, h) bind(C, name="sm_set_spacing_const") result(s)
+      import :: c_ptr, c_double, c_int32_t
+      type(c_ptr), value :: m
+      real(c_double), value :: h
+      integer(c_int32_t) :: s
+    end function sm_set_spacing_const
+
+    function sm_set_param_c(m, name, value) bind(C, name="sm_set_param") result(s)
+      import :: c_ptr, c_char, c_double, c_int32_t
+      type(c_ptr), value :: m
+      character(kind=c_char), intent(in) :: name(*)
+      real(c_double), value :: value
+      integer(c_int32_t) :: s
+    end function sm_set_param_c
+
+    function sm_get_param_c(m, name, value) bind(C, name="sm_get_param") result(s)
+      import :: c_ptr, c_char, c_double, c_int32_t
+      type(c_ptr), value :: m
+      character(kind=c_char), intent(in) :: name(*)
+      real(c_double), intent(out) :: value
+      integer(c_int32_t) :: s
+    end function sm_get_param_c
+
+    function sm_set_progress_cb(m, f, user_data) bind(C, name="sm_set_progress_cb") result(s)
+      import :: c_ptr, c_funptr, c_int32_t
+      type(c_ptr), value :: m
+      type(c_funptr), value :: f
+      type(c_ptr), value :: user_data
+      integer(c_int32_t) :: s
+    end function sm_set_progress_cb
+
+    function sm_refine(m) bind(C, name="sm_refine") result(s)
+      import :: c_ptr, c_int32_t
+      type(c_ptr), value :: m
+      integer(c_int32_t) :: s
+    end function sm_refine
+
+    function sm_num_vertices(m) bind(C, name="sm_num_vertices") result(n)
+      import :: c_ptr, c_size_t
+      type(c_ptr), value :: m
+      integer(c_size_t) :: n
+    end function sm_num_vertices
+
+    function sm_num_tets(m) bind(C, name="sm_num_tets") result(n)
+      import :: c_ptr, c_size_t
+      type(c_ptr), value :: m
+      integer(c_size_t) :: n
+    end function sm_num_tets
+
+    function sm_num_boundary_faces(m) bind(C, name="sm_num_boundary_faces") result(n)
+      import :: c_ptr, c_size_t
+      type(c_ptr), value :: m
+      integer(c_size_t) :: n
+    end function sm_num_boundary_faces
+
+    !> xyz(3, capacity)
+    function sm_get_vertices(m, xyz, capacity) bind(C, name="sm_get_vertices") result(s)
+      import :: c_ptr, c_double, c_size_t, c_int32_t
+      type(c_ptr), value :: m
+      real(c_double), intent(inout) :: xyz(*)
+      integer(c_size_t), value :: capacity
+      integer(c_int32_t) :: s
+    end function sm_get_vertices
+
+    !> tets(4, capacity) 0-based ids; regions(capacity) may be omitted (NULL).
+    function sm_get_tets(m, tets, regions, capacity) bind(C, name="sm_get_tets") result(s)
+      import :: c_ptr, c_size_t, c_int32_t
+      type(c_ptr), value :: m
+      integer(c_int32_t), intent(inout) :: tets(*)
+      integer(c_int32_t), intent(inout), optional :: regions(*)
+      integer(c_size_t), value :: capacity
+      integer(c_int32_t) :: s
+    end function sm_get_tets
+
+    !> tris(3, capacity) 0-based ids; markers(capacity) may be omitted (NULL).
+    function sm_get_boundary_faces(m, tris, markers, capacity) &
+        bind(C, name="sm_get_boundary_faces") result(s)
+      import :: c_ptr, c_size_t, c_int32_t
+      type(c_ptr), value :: m
+      integer(c_int32_t), intent(inout) :: tris(*)
+      integer(c_int32_t), intent(inout), optional :: markers(*)
+      integer(c_size_t), value :: capacity
+      integer(c_int32_t) :: s
+    end function sm_get_boundary_faces
+
+    function sm_get_quality(m, out) bind(C, name="sm_get_quality") result(s)
+      import :: c_ptr, c_int32_t, sm_quality
+      type(c_ptr), value :: m
+      type(sm_quality), intent(inout) :: out
+      integer(c_int32_t) :: s
+    end function sm_get_quality
+
+    function sm_write_c(m, path) bind(C, name="sm_write") result(s)
+      import :: c_ptr, c_char, c_int32_t
+      type(c_ptr), value :: m
+      character(kind=c_char), intent(in) :: path(*)
+      integer(c_int32_t) :: s
+    end function sm_write_c
+
+    function sm_last_error_c(m) bind(C, name="sm_last_error") result(p)
+      import :: c_ptr
+      type(c_ptr), value :: m
+      type(c_ptr) :: p
+    end function sm_last_error_c
+
+    function sm_stop_reason_c(m) bind(C, name="sm_stop_reason") result(p)
+      import :: c_ptr
+      type(c_ptr), value :: m
+      type(c_ptr) :: p
+    end function sm_stop_reason_c
+
+    function sm_status_str_c(s) bind(C, name="sm_status_str") result(p)
+      import :: c_ptr, c_int32_t
+      integer(c_int32_t), value :: s
+      type(c_ptr) :: p
+    end function sm_status_str_c
+
+    function sm_version_c() bind(C, name="sm_version") result(p)
+      import :: c_ptr
+      type(c_ptr) :: p
+    end function sm_version_c
+
+    function c_strlen(p) bind(C, name="strlen") result(n)
+      import :: c_ptr, c_size_t
+      type(c_ptr), value :: p
+      integer(c_size_t) :: n
+    end function c_strlen
+  end interface
+
+  public :: sm_create, sm_destroy, sm_add_vertices, sm_add_facet, sm_add_facet_hole, &
+            sm_add_hole, sm_add_region, sm_set_spacing_cb, sm_set_spacing_batch_cb, &
+            sm_set_spacing_const, sm_set_param_c, sm_get_param_c, sm_set_progress_cb, &
+            sm_refine, sm_num_vertices, sm_num_tets, sm_num_boundary_faces, sm_get_vertices, &
+            sm_get_tets, sm_get_boundary_faces, sm_get_quality, sm_write_c, sm_last_error_c, &
+            sm_stop_reason_c, sm_status_str_c, sm_version_c
+  public :: sm_set_param, sm_get_param, sm_write, sm_last_error, sm_stop_reason, &
+            sm_status_str, sm_version
+
+contains
+
+  !> A Fortran string as a NUL-terminated C string.
+  pure function c_string(s) result(c)
+    character(len=*), intent(in) :: s
+    character(kind=c_char, len=len_trim(s) + 1) :: c
+    c = trim(s) // c_null_char
+  end function c_string
+
+  !> A copy of the NUL-terminated C string at p ("" for a NULL pointer).
+  function f_string(p) result(s)
+    type(c_ptr), intent(in) :: p
+    character(len=:), allocatable :: s
+    character(kind=c_char), pointer :: chars(:)
+    integer :: i, n
+    if (.not. c_associated(p)) then
+      s = ""
+      return
+    end if
+    n = int(c_strlen(p))
+    call c_f_pointer(p, chars, [n])
+    allocate (character(len=n) :: s)
+    do i = 1, n
+      s(i:i) = chars(i)
+    end do
+  end function f_string
+
+  !> sm_set_param with a Fortran string name ("rho0", "sigma0", "seed", ...).
+  function sm_set_param(m, name, value) result(s)
+    type(c_ptr), intent(in) :: m
+    character(len=*), intent(in) :: name
+    real(c_double), intent(in) :: value
+    integer(c_int32_t) :: s
+    s = sm_set_param_c(m, c_string(name), value)
+  end function sm_set_param
+
+  !> sm_get_param with a Fortran string name.
+  function sm_get_param(m, name, value) result(s)
+    type(c_ptr), intent(in) :: m
+    character(len=*), intent(in) :: name
+    real(c_double), intent(out) :: value
+    integer(c_int32_t) :: s
+    s = sm_get_param_c(m, c_string(name), value)
+  end function sm_get_param
+
+  !> sm_write with a Fortran string path (format by extension: .vtu, .mesh, .msh, .node).
+  function sm_write(m, path) result(s)
+    type(c_ptr), intent(in) :: m
+    character(len=*), intent(in) :: path
+    integer(c_int32_t) :: s
+    s = sm_write_c(m, c_string(path))
+  end function sm_write
+
+  !> The message of the last fallible call on m ("" after a success).
+  function sm_last_error(m) result(msg)
+    type(c_ptr), intent(in) :: m
+    character(len=:), allocatable :: msg
+    msg = f_string(sm_last_error_c(m))
+  end function sm_last_error
+
+  !> Why the last sm_refine stopped early ("" if it completed).
+  function sm_stop_reason(m) result(msg)
+    type(c_ptr), intent(in) :: m
+    character(len=:), allocatable :: msg
+    msg = f_string(sm_stop_reason_c(m))
+  end function sm_stop_reason
+
+  !> A description of a status code.
+  function sm_status_str(s) result(msg)
+    integer(c_int32_t), intent(in) :: s
+    character(len=:), allocatable :: msg
+    msg = f_string(sm_status_str_c(s))
+  end function sm_status_str
+
+  !> The library version.
+  function sm_version() result(v)
+    character(len=:), allocatable :: v
+    v = f_string(sm_version_c())
+  end function sm_version
+
+end module slivermesh

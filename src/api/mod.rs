@@ -1,0 +1,33 @@
+//! The safe Rust API: what Rust users, the CLI and the C ABI (`ffi`) call.
+//!
+//! - [`Mesher`] (`mesher.rs`): builder for a domain, parameters, spacing and progress; runs
+//!   `refine::mesh` and keeps the result.
+//! - [`params`]: parameters set and read by name, with range checks that give a reason.
+//! - [`SpacingChoice`] (`spacing.rs`): automatic, constant or user spacing, and the guard that
+//!   turns any spacing value that is not finite and positive into an error naming the point.
+//! - [`MeshOutput`], [`QualityFields`] (`output.rs`): the result and its writing with per-tet
+//!   quality as cell data.
+//! - [`Error`] (`error.rs`): the one error type.
+//!
+//! No `unsafe` here: the C ABI's raw pointers stay in `ffi`.
+
+#![deny(unsafe_code)]
+
+mod error;
+mod mesher;
+mod output;
+pub mod params;
+mod spacing;
+
+pub use error::Error;
+pub use mesher::{Mesher, ProgressFn};
+pub use output::{MeshOutput, QualityFields};
+pub use params::{Params, PARAM_NAMES};
+pub use spacing::SpacingChoice;
+
+pub use crate::mesh::TetMesh;
+pub use crate::plc::PlcInput;
+pub use crate::refine::{ConstantSpacing, FnSpacing, MeshError, Report, Spacing};
+
+#[cfg(test)]
+mod tests;

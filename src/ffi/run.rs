@@ -1,0 +1,33 @@
+//! Running the mesher.
+
+use super::guard::handle_call;
+use super::mesher::sm_mesher;
+use super::status::*;
+use crate::refine::Spacing;
+use std::ffi::CString;
+
+/// Meshes the domain: validation, boundary recovery, then quality refinement (unless the
+/// "refine" parameter is 0). On success the mesh replaces any previous one; on failure there is
+/// no mesh and `sm_last_error` says why: `SM_ERR_INVALID_INPUT` (the domain, naming the facet or
+/// vertex), `SM_ERR_SPACING` (a spacing value that is not finite and positive, naming the point),
+/// `SM_ERR_CANCELLED` (the progress callback), `SM_ERR_INTERNAL`.
+///
+/// # Safety
+/// `m` is NULL or a live handle; registered callbacks and their `user_data` are valid.
+#[no_mangle]
+pub unsafe extern "C" fn sm_refine(m: *mut sm_mesher) -> sm_status {
+    // SAFETY: `m` is NULL or a live handle (contract above).
+    let handle = unsafe { m.as_ref() };
+    handle_call(handle, "sm_refine", |st| {
+        st.stop_reason = None;
+        let spacing = st.spacing_cb.as_ref().map(|s| s as &dyn Spacing);
+        let progress_cb = st.progress_cb;
+        let mut relay = |fraction: f64, n: usize| progress_cb.map_or(true, |p| p.call(fraction, n));
+        let report = st.mesher.refine_with(spacing, Some(&mut relay))?;
+        st.stop_reason = report
+            .stop_reason
+            .as_deref()
+            .map(|r| CString::new(r.replace('\0', " ")).unwrap_or_default());
+        Ok(())
+    })
+}

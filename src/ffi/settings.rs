@@ -1,0 +1,142 @@
+//! Settings: parameters by name, the spacing (constant or callback) and the progress callback.
+
+use super::callbacks::{sm_progress_fn, sm_spacing_batch_fn, sm_spacing_fn, CProgress, CSpacing};
+use super::guard::handle_call;
+use super::mesher::sm_mesher;
+use super::slices::utf8;
+use super::status::*;
+use std::ffi::{c_char, c_void};
+
+/// Sets a refinement parameter by name: "rho0" (radius-edge bound R/L, >= 0.7, default 2),
+/// "sigma0" (sliver bound V/L^3 in [0, 0.1179), default 0.02; 0 = off), "min_dihedral" (degrees
+/// in [0, 70.5): tets with a smaller dihedral angle count as slivers, default 15; 0 = off),
+/// "delta" (picking-ball factor in (0, 1), default 0.3), "b" (small-sliver radius factor > 0,
+/// default 4), "size_factor" or "B" (R/f(c) bound > 0, default 1), "seed" (whole number,
+/// default 1), "max_vertices" (whole number, at least 4; refinement stops there, reporting
+/// complete = 0), "max_tries" (whole number, at least 1), "refine" (1, or 0 for boundary
+/// recovery only).
+/// An unknown name or out-of-range value gives `SM_ERR_INVALID_ARGUMENT`; `sm_last_error`
+/// says why (and lists the valid names).
+///
+/// # Safety
+/// `m` is NULL or a live handle; `name` is NULL or a NUL-terminated string.
+#[no_mangle]
+pub unsafe extern "C" fn sm_set_param(
+    m: *mut sm_mesher,
+    name: *const c_char,
+    value: f64,
+) -> sm_status {
+    // SAFETY: `m` is NULL or a live handle (contract above).
+    let handle = unsafe { m.as_ref() };
+    handle_call(handle, "sm_set_param", |st| {
+        // SAFETY: `name` is NULL or NUL-terminated (contract above).
+        let name = unsafe { utf8("name", name) }?;
+        st.mesher.set_param(name, value)?;
+        Ok(())
+    })
+}
+
+/// Reads a refinement parameter by name (names as `sm_set_param`) into `*value`.
+///
+/// # Safety
+/// `m` is NULL or a live handle; `name` is NULL or a NUL-terminated string; `value` is NULL or
+/// points to a writable double.
+#[no_mangle]
+pub unsafe extern "C" fn sm_get_param(
+    m: *const sm_mesher,
+    name: *const c_char,
+    value: *mut f64,
+) -> sm_status {
+    // SAFETY: `m` is NULL or a live handle (contract above).
+    let handle = unsafe { m.as_ref() };
+    handle_call(handle, "sm_get_param", |st| {
+        // SAFETY: `name` is NULL or NUL-terminated (contract above).
+        let name = unsafe { utf8("name", name) }?;
+        if value.is_null() {
+            return Err(FfiError::null("value"));
+        }
+        let v = st.mesher.param(name)?;
+        // SAFETY: `value` is non-null and writable (contract above).
+        unsafe { value.write(v) };
+        Ok(())
+    })
+}
+
+/// Uses the same target element size `h` (finite, > 0) everywhere; replaces any spacing
+/// callback.
+///
+/// # Safety
+/// `m` is NULL or a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn sm_set_spacing_const(m: *mut sm_mesher, h: f64) -> sm_status {
+    // SAFETY: `m` is NULL or a live handle (contract above).
+    let handle = unsafe { m.as_ref() };
+    handle_call(handle, "sm_set_spacing_const", |st| {
+        st.mesher.set_spacing_constant(h)?;
+        st.spacing_cb = None;
+        Ok(())
+    })
+}
+
+/// Uses `f(x, y, z, user_data)` as the spacing function (see `sm_spacing_fn`); replaces a
+/// constant or batched spacing. `f` == NULL removes it: spacing becomes automatic. `user_data` is
+/// passed back untouched; it must stay valid while the handle may call `f` (during `sm_refine`).
+///
+/// # Safety
+/// `m` is NULL or a live handle; `f` is NULL or a function with the `sm_spacing_fn` signature
+/// that does not unwind (no C++ exception, no Fortran error stop escaping it).
+#[no_mangle]
+pub unsafe extern "C" fn sm_set_spacing_cb(
+    m: *mut sm_mesher,
+    f: sm_spacing_fn,
+    user_data: *mut c_void,
+) -> sm_status {
+    // SAFETY: `m` is NULL or a live handle (contract above).
+    let handle = unsafe { m.as_ref() };
+    handle_call(handle, "sm_set_spacing_cb", |st| {
+        st.mesher.set_spacing_automatic();
+        st.spacing_cb = f.map(|f| CSpacing::point(f, user_data));
+        Ok(())
+    })
+}
+
+/// Uses the batched `f(n, xyz, out, user_data)` as the spacing function (see
+/// `sm_spacing_batch_fn`: one call per batch of points); replaces any other spacing. `f` == NULL
+/// removes it: spacing becomes automatic.
+///
+/// # Safety
+/// As `sm_set_spacing_cb`, with the `sm_spacing_batch_fn` signature.
+#[no_mangle]
+pub unsafe extern "C" fn sm_set_spacing_batch_cb(
+    m: *mut sm_mesher,
+    f: sm_spacing_batch_fn,
+    user_data: *mut c_void,
+) -> sm_status {
+    // SAFETY: `m` is NULL or a live handle (contract above).
+    let handle = unsafe { m.as_ref() };
+    handle_call(handle, "sm_set_spacing_batch_cb", |st| {
+        st.mesher.set_spacing_automatic();
+        st.spacing_cb = f.map(|f| CSpacing::batch(f, user_data));
+        Ok(())
+    })
+}
+
+/// Calls `f(fraction, n_vertices, user_data)` during `sm_refine` (once with 0 before any work);
+/// a non-zero return cancels it with `SM_ERR_CANCELLED`. `f` == NULL removes the callback.
+///
+/// # Safety
+/// `m` is NULL or a live handle; `f` is NULL or a function with the `sm_progress_fn` signature
+/// that does not unwind.
+#[no_mangle]
+pub unsafe extern "C" fn sm_set_progress_cb(
+    m: *mut sm_mesher,
+    f: sm_progress_fn,
+    user_data: *mut c_void,
+) -> sm_status {
+    // SAFETY: `m` is NULL or a live handle (contract above).
+    let handle = unsafe { m.as_ref() };
+    handle_call(handle, "sm_set_progress_cb", |st| {
+        st.progress_cb = f.map(|f| CProgress::new(f, user_data));
+        Ok(())
+    })
+}
