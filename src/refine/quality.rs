@@ -105,6 +105,10 @@ impl<'a> Refiner<'a> {
     }
 
     fn classify(&self, t: u32) -> Result<Option<Bad>, MeshError> {
+        // Tets logged as created may have been deleted again by a later insertion.
+        if !self.dom.dt.is_alive(t) {
+            return Ok(None);
+        }
         let tag = self.dom.dt.tag(t);
         if tag == 0 || !self.dom.dt.is_finite(t) {
             return Ok(None);
