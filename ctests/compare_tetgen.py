@@ -201,9 +201,8 @@ def run_ours(exe, poly, workdir, size, extra):
     return res
 
 
-def best_of(first, rerun, repeat):
-    """first: the calibration's final run; reruns until there are `repeat` timings; keeps the fastest."""
-    runs = [first] + [rerun() for _ in range(repeat - 1)]
+def best_of(runs):
+    """The fastest of several runs at the same size."""
     best = dict(min(runs, key=lambda r: r["seconds"]))
     best["all_seconds"] = [round(r["seconds"], 4) for r in runs]
     return best
@@ -265,9 +264,15 @@ def main():
         h, ours_first = match_count(ours_at, args.tets, (5.1 / args.tets) ** (1.0 / 3.0), 3.0,
                                     args.tol, args.max_runs, "slivermesh")
         # The closest calibration run counts as the first timing, unless a later run overwrote its
-        # files; best_of's reruns then leave the chosen size's files on disk.
-        tg = best_of(tg_first if last["tetgen"] == v else tg_at(v), lambda: tg_at(v), args.repeat)
-        ours = best_of(ours_first if last["slivermesh"] == h else ours_at(h), lambda: ours_at(h), args.repeat)
+        # files. The reruns alternate between the programs so a change in machine load hits both,
+        # and leave the chosen sizes' files on disk.
+        tg_runs = [tg_first] if last["tetgen"] == v else []
+        ours_runs = [ours_first] if last["slivermesh"] == h else []
+        while len(tg_runs) < args.repeat or len(ours_runs) < args.repeat or \
+                last["tetgen"] != v or last["slivermesh"] != h:
+            tg_runs.append(tg_at(v))
+            ours_runs.append(ours_at(h))
+        tg, ours = best_of(tg_runs), best_of(ours_runs)
 
         tg_q = measure(*read_node_ele(tg["stem"]))
         ours_q = measure(*read_node_ele(ours["stem"]))
