@@ -15,6 +15,10 @@ MODEL-cgal.vtu and MODEL-slivermesh.vtu, with cell data region, radius_edge_rati
 min_dihedral_deg, max_dihedral_deg (slivermesh's own writer's file is kept beside them as
 MODEL-slivermesh-native.vtu).
 
+With --repeat N both programs rerun N-1 more times at the chosen sizes and the fastest run of each
+is the one in the table; the files are the last run's. CGAL's runs at one size can differ by a
+few tets (its mesh depends on memory addresses), slivermesh's are identical (fixed seed).
+
 Checks (exit status 1 with "FAIL: ..." lines; 2 for usage errors): both programs succeed;
 slivermesh reports complete: true; the tet counts are within --count-tol (20%); no inverted tets
 and equal volumes; our minimum dihedral angle measured by cgal_mesh3 equals slivermesh's report;
