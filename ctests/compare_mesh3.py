@@ -1,0 +1,254 @@
+#!/usr/bin/env python3
+"""Compare slivermesh's quality meshing with CGAL Mesh_3 (perturb + exude) at comparable tet counts.
+
+For each --input .off (default: the acute-free off/cube.off and off/cross.off):
+  1. `slivermesh mesh INPUT --size H` with H adjusted until about --tets tets;
+  2. `cgal_mesh3 mesh INPUT --size S` (Polyhedral_mesh_domain_with_features_3, detect_features(),
+     facet_angle 25, cell_radius_edge_ratio 2, edge/facet/cell size S, facet distance S/10,
+     make_mesh_3 with perturb() and exude()) with S adjusted until its tet count is within --tol of
+     ours;
+  3. `cgal_mesh3 measure` on our .vtu, so both meshes are measured by the same code (and ours is
+     checked against slivermesh's own report);
+and prints the side-by-side table: tets, seconds, tets/s, min/max dihedral, max radius-edge
+ratio, min sigma = V/L^3. Both meshes are written through VTK into --outdir as
+MODEL-cgal.vtu and MODEL-slivermesh.vtu, with cell data region, radius_edge_ratio, sigma,
+min_dihedral_deg, max_dihedral_deg (slivermesh's own writer's file is kept beside them as
+MODEL-slivermesh-native.vtu).
+
+With --repeat N both programs rerun N-1 more times at the chosen sizes and the fastest run of each
+is the one in the table; the files are the last run's. CGAL's runs at one size can differ by a
+few tets (its mesh depends on memory addresses), slivermesh's are identical (fixed seed).
+
+Checks (exit status 1 with "FAIL: ..." lines; 2 for usage errors): both programs succeed;
+slivermesh reports complete: true; the tet counts are within --count-tol (20%); no inverted tets
+and equal volumes; our minimum dihedral angle measured by cgal_mesh3 equals slivermesh's report;
+our minimum dihedral angle is larger than CGAL's. Times are printed, never asserted.
+
+Examples:
+  compare_mesh3.py --tets 4000                     # the ctest size, both models
+  compare_mesh3.py --tets 200000 --outdir cmp      # the benchmark, keep the .vtu files
+"""
+
+import argparse
+import json
+import os
+import shutil
+import sys
+import tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from meshcompare import Failure, check_executable, match_count, run_timed, table  # noqa: E402
+
+
+def off_volume(path):
+    """Volume enclosed by an OFF polyhedron (fan-triangulated faces, divergence theorem)."""
+    with open(path) as f:
+        words = [w for line in f for w in line.split("#", 1)[0].split()]
+    try:
+        if words[0] != "OFF":
+            raise ValueError("no OFF header")
+        nv, nf = int(words[1]), int(words[2])
+        pos = 4
+        pts = []
+        for _ in range(nv):
+            pts.append(tuple(float(w) for w in words[pos:pos + 3]))
+            pos += 3
+        six_v = 0.0
+        for _ in range(nf):
+            k = int(words[pos])
+            ids = [int(w) for w in words[pos + 1:pos + 1 + k]]
+            pos += 1 + k
+            a = pts[ids[0]]
+            for i in range(1, k - 1):
+                b, c = pts[ids[i]], pts[ids[i + 1]]
+                six_v += (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                          + a[2] * (b[0] * c[1] - b[1] * c[0]))
+    except (IndexError, ValueError) as e:
+        raise Failure("%s: cannot read as OFF (%s)" % (path, e))
+    return abs(six_v) / 6.0
+
+
+def load_json(text, who):
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as e:
+        raise Failure("%s printed invalid JSON (%s):\n%s" % (who, e, text))
+
+
+def compare_model(args, model, outdir):
+    name = os.path.splitext(os.path.basename(model))[0]
+    volume = off_volume(model)
+    ours_native = os.path.join(outdir, name + "-slivermesh-native.vtu")
+    ours_vtk = os.path.join(outdir, name + "-slivermesh.vtu")
+    cgal_vtu = os.path.join(outdir, name + "-cgal.vtu")
+    stats = os.path.join(outdir, name + "-slivermesh-stats.json")
+    last = {}
+
+    def ours_at(h):
+        last["ours"] = h
+        cmd = [args.slivermesh, "mesh", model, "-o", ours_native, "--size", "%.10g" % h,
+               "--stats-json", stats] + args.slivermesh_arg
+        _, wall = run_timed(cmd)
+        with open(stats) as f:
+            res = json.load(f)
+        res.update({"size": h, "wall_seconds": wall,
+                    "command": "slivermesh mesh %s --size %.6g %s" % (os.path.basename(model), h,
+                                                                      " ".join(args.slivermesh_arg))})
+        return res
+
+    def cgal_at(s):
+        last["cgal"] = s
+        cmd = [args.cgal_mesh3, "mesh", model, "--size", "%.10g" % s, "--vtu", cgal_vtu]
+        out, wall = run_timed(cmd)
+        res = load_json(out, "cgal_mesh3")
+        res.update({"wall_seconds": wall,
+                    "command": "cgal_mesh3 mesh %s --size %.6g" % (os.path.basename(model), s)})
+        return res
+
+    print("%s (volume %.6g), target %d tets; choosing sizes:" % (model, volume, args.tets))
+    h, ours = match_count(ours_at, args.tets, (5.1 * volume / args.tets) ** (1.0 / 3.0), 3.0,
+                          args.tol, args.max_runs, "slivermesh")
+    if last["ours"] != h:
+        ours = ours_at(h)  # leave the chosen mesh's files on disk
+    s, cgal = match_count(cgal_at, ours["n_tets"], (4.6 * volume / ours["n_tets"]) ** (1.0 / 3.0),
+                          3.0, args.tol, args.max_runs, "CGAL Mesh_3")
+    if last["cgal"] != s:
+        cgal = cgal_at(s)
+    for _ in range(args.repeat - 1):  # timing reruns, best kept
+        o, c = ours_at(h), cgal_at(s)
+        if o["seconds_total"] < ours["seconds_total"]:
+            ours = o
+        if c["seconds_total"] < cgal["seconds_total"]:
+            cgal = c
+
+    out, _ = run_timed([args.cgal_mesh3, "measure", ours_native, "--vtu", ours_vtk])
+    ours_m = load_json(out, "cgal_mesh3 measure")
+
+    # The table: CGAL's figures are its own program's; ours are measured by the same code
+    # (cgal_mesh3 measure), the time is slivermesh's report.
+    ours_row = dict(ours_m)
+    for key in ("seconds_total", "wall_seconds", "complete"):
+        ours_row[key] = ours.get(key)
+    for r in (cgal, ours_row):
+        r["tets_per_second"] = r["n_tets"] / r["seconds_total"] if r["seconds_total"] else None
+    cgal["complete"] = True
+    cgal["param"], ours_row["param"] = "--size %.4g" % s, "--size %.4g" % h
+    rows = [
+        ("size parameter", "param", "s", False),
+        ("vertices", "n_vertices", "d", True),
+        ("tets", "n_tets", "d", True),
+        ("seconds (meshing)", "seconds_total", ".3f", True),
+        ("seconds (process wall)", "wall_seconds", ".3f", True),
+        ("tets/s (meshing)", "tets_per_second", ",.0f", True),
+        ("min dihedral (deg)", "min_dihedral_deg", ".2f", True),
+        ("max dihedral (deg)", "max_dihedral_deg", ".2f", True),
+        ("max radius-edge R/L", "max_rho", ".3f", True),
+        ("min sigma V/L^3", "min_sigma", ".4f", True),
+        ("tets < 5/10/15/20 deg", "tets_below_deg", "", False),
+        ("volume", "volume", ".9g", False),
+        ("complete", "complete", "", False),
+    ]
+    print()
+    print("quality meshing of %s: %s vs %s" % (os.path.basename(model), cgal["command"], ours["command"]))
+    print(table(rows, cgal, ours_row, "CGAL"))
+    print("min dihedral: slivermesh %.2f deg, CGAL Mesh_3 %.2f deg (difference %+.2f deg)"
+          % (ours_m["min_dihedral_deg"], cgal["min_dihedral_deg"],
+             ours_m["min_dihedral_deg"] - cgal["min_dihedral_deg"]))
+    print("VTK files: %s, %s" % (cgal_vtu, ours_vtk))
+    print()
+
+    failures = []
+    if not ours.get("complete"):
+        failures.append("%s: slivermesh did not complete: %s" % (name, ours.get("stop_reason")))
+    ratio = ours["n_tets"] / cgal["n_tets"]
+    if abs(ratio - 1.0) > args.count_tol:
+        failures.append("%s: tet counts not comparable: slivermesh %d, CGAL %d (ratio %.3f, allowed +-%.0f%%)"
+                        % (name, ours["n_tets"], cgal["n_tets"], ratio, 100 * args.count_tol))
+    for who, r in (("CGAL", cgal), ("slivermesh", ours_m)):
+        if r["n_inverted"]:
+            failures.append("%s: %s mesh has %d tets with volume <= 0" % (name, who, r["n_inverted"]))
+        if abs(r["volume"] - volume) > 1e-9 * max(1.0, volume):
+            failures.append("%s: %s mesh volume %.12g, the polyhedron's %.12g"
+                            % (name, who, r["volume"], volume))
+    if ours_m["n_tets"] != ours["n_tets"] or abs(ours_m["min_dihedral_deg"] - ours["min_dihedral_deg"]) > 1e-6:
+        failures.append("%s: slivermesh reports %d tets, min dihedral %.9f; measured from its .vtu: %d, %.9f"
+                        % (name, ours["n_tets"], ours["min_dihedral_deg"], ours_m["n_tets"],
+                           ours_m["min_dihedral_deg"]))
+    if not ours_m["min_dihedral_deg"] > cgal["min_dihedral_deg"]:
+        failures.append("%s: slivermesh's minimum dihedral angle %.3f deg is not larger than CGAL Mesh_3's %.3f deg"
+                        % (name, ours_m["min_dihedral_deg"], cgal["min_dihedral_deg"]))
+    return {"model": model, "volume": volume, "cgal": cgal, "slivermesh": ours_row,
+            "slivermesh_report": ours, "failures": failures}
+
+
+def main():
+    here = os.path.dirname(os.path.abspath(__file__))
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--slivermesh", default=os.path.join(here, "..", "target", "release", "slivermesh"))
+    ap.add_argument("--cgal-mesh3", default=os.path.join(here, "..", "build", "ctests", "cgal_mesh3"))
+    ap.add_argument("--input", action="append",
+                    help="an .off model (repeatable; default: off/cube.off and off/cross.off of the shared models)")
+    ap.add_argument("--tets", type=int, default=4000, help="target number of tets (default 4000)")
+    ap.add_argument("--repeat", type=int, default=1, help="timed runs per program, fastest kept (default 1)")
+    ap.add_argument("--tol", type=float, default=0.05,
+                    help="stop adjusting a size when within this fraction of the target (default 0.05)")
+    ap.add_argument("--count-tol", type=float, default=0.20,
+                    help="fail unless the two tet counts are within this fraction (default 0.20)")
+    ap.add_argument("--max-runs", type=int, default=6, help="calibration runs per program (default 6)")
+    ap.add_argument("--slivermesh-arg", action="append", default=[],
+                    help="extra argument for `slivermesh mesh` (repeatable), e.g. --slivermesh-arg=--min-dihedral=20")
+    ap.add_argument("--outdir", help="write the .vtu files here (default: a temp dir, removed)")
+    ap.add_argument("--json-out", help="write every result to this JSON file")
+    args = ap.parse_args()
+
+    if not args.input:
+        for models in (os.path.join(here, "..", "..", "shared", "models"), "/work/shared/models"):
+            if os.path.isdir(models):
+                args.input = [os.path.abspath(os.path.join(models, "off", m)) for m in ("cube.off", "cross.off")]
+                break
+    for m in args.input or [None]:
+        if not m or not os.path.isfile(m):
+            print("error: input model not found: %s" % m, file=sys.stderr)
+            return 2
+    if not (check_executable("slivermesh", args.slivermesh) and check_executable("cgal_mesh3", args.cgal_mesh3)):
+        return 2
+    if args.repeat < 1 or args.tets < 50:
+        print("error: --repeat must be >= 1 and --tets >= 50", file=sys.stderr)
+        return 2
+
+    own_tmp = args.outdir is None
+    outdir = tempfile.mkdtemp(prefix="slivermesh-vs-mesh3-") if own_tmp else args.outdir
+    os.makedirs(outdir, exist_ok=True)
+    failures, results = [], []
+    try:
+        for model in args.input:
+            try:
+                r = compare_model(args, model, outdir)
+                results.append(r)
+                failures += r["failures"]
+            except Failure as e:
+                failures.append("%s: %s" % (os.path.basename(model), e))
+        if len(results) > 1:
+            print("%-12s %8s %8s %10s %10s %9s %9s" % ("summary", "tets", "tets", "min dih", "min dih", "seconds", "seconds"))
+            print("%-12s %8s %8s %10s %10s %9s %9s" % ("", "CGAL", "ours", "CGAL", "ours", "CGAL", "ours"))
+            for r in results:
+                c, o = r["cgal"], r["slivermesh"]
+                print("%-12s %8d %8d %10.2f %10.2f %9.3f %9.3f"
+                      % (os.path.basename(r["model"]), c["n_tets"], o["n_tets"], c["min_dihedral_deg"],
+                         o["min_dihedral_deg"], c["seconds_total"], o["seconds_total"]))
+        if args.json_out:
+            with open(args.json_out, "w") as f:
+                json.dump({"target_tets": args.tets, "results": results, "failures": failures}, f, indent=2)
+                f.write("\n")
+    finally:
+        if own_tmp:
+            shutil.rmtree(outdir, ignore_errors=True)
+    for msg in failures:
+        print("FAIL: " + msg, file=sys.stderr)
+    if not failures:
+        print("OK")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
