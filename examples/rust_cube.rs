@@ -6,7 +6,9 @@ use slivermesh::api::{Error, Mesher};
 use slivermesh::DVec3;
 
 fn main() -> Result<(), Error> {
-    let out = std::env::args().nth(1).unwrap_or_else(|| "cube_rust.vtu".into());
+    let out = std::env::args()
+        .nth(1)
+        .unwrap_or_else(|| "cube_rust.vtu".into());
     let corners: Vec<DVec3> = (0..8)
         .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
         .collect();

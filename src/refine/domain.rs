@@ -42,12 +42,24 @@ pub struct Domain {
     pub subfacets: FxHashMap<[u32; 3], u32>,
     /// Input vertices where two segments meet at an acute angle (split by concentric shells).
     pub acute_vertices: FxHashSet<u32>,
+    /// Input vertices where segments meet at a small angle (< SMALL_ANGLE_DEG).
+    pub small_angle_vertices: FxHashSet<u32>,
+    /// Input segments (indices into `segments`) in a small input angle: between two facets
+    /// meeting at less than SMALL_ANGLE_DEG, or ending at a small-angle vertex.
+    pub acute_segments: FxHashSet<u32>,
+    /// Input facets holding a small-angle vertex or segment.
+    pub acute_facets: FxHashSet<u32>,
     /// Subsegments and subfacets to check for encroachment (see `recover::settle`).
     pub dirty_segs: Vec<(u32, u32)>,
     pub dirty_tris: Vec<[u32; 3]>,
     /// Tets created by insertions since the refiner last looked (it classifies them).
     pub created_log: Vec<u32>,
 }
+
+/// Input angles below this (between segments at a vertex, or between facets at a segment) are
+/// "small": refinement does not enforce shape bounds next to them. Angles between 60 and 90
+/// degrees are acute too, but refinement terminates around them in practice (Shewchuk).
+pub const SMALL_ANGLE_DEG: f64 = 60.0;
 
 pub fn seg_key(a: u32, b: u32) -> (u32, u32) {
     (a.min(b), a.max(b))
@@ -117,10 +129,61 @@ impl Domain {
             markers,
             subfacets,
             acute_vertices,
+            small_angle_vertices: FxHashSet::default(),
+            acute_segments: FxHashSet::default(),
+            acute_facets: FxHashSet::default(),
             dirty_segs: vec![],
             dirty_tris: vec![],
             created_log: vec![],
         })
+    }
+
+    /// Records the small input angles the validator found (see `near_acute`).
+    pub fn set_acute_angles(&mut self, plc: &crate::plc::Plc) {
+        let acute = plc.acute_angles();
+        for a in acute
+            .segment_angles
+            .iter()
+            .filter(|a| a.degrees < SMALL_ANGLE_DEG)
+        {
+            self.small_angle_vertices.insert(a.vertex);
+        }
+        let index: FxHashMap<(u32, u32), u32> = self
+            .segments
+            .iter()
+            .enumerate()
+            .map(|(i, s)| (seg_key(s.ends[0], s.ends[1]), i as u32))
+            .collect();
+        for a in acute
+            .dihedral_angles
+            .iter()
+            .filter(|a| a.degrees < SMALL_ANGLE_DEG)
+        {
+            let v = plc.segments[a.segment].vertices;
+            if let Some(&s) = index.get(&seg_key(v[0], v[1])) {
+                self.acute_segments.insert(s);
+            }
+        }
+        for (i, s) in self.segments.iter().enumerate() {
+            if s.ends.iter().any(|v| self.small_angle_vertices.contains(v)) {
+                self.acute_segments.insert(i as u32);
+            }
+        }
+        for &s in &self.acute_segments {
+            self.acute_facets
+                .extend(self.segments[s as usize].facets.iter().copied());
+        }
+    }
+
+    /// Whether vertex `v` lies on an input feature with an acute angle, where quality cannot
+    /// always be enforced without an endless cascade of boundary splits.
+    pub fn near_acute(&self, v: u32) -> bool {
+        match self.kind[v as usize] {
+            VertexKind::Input => self.small_angle_vertices.contains(&v),
+            VertexKind::Segment(s) => self.acute_segments.contains(&s),
+            VertexKind::Facet(f) => self.acute_facets.contains(&f),
+            VertexKind::Volume => false,
+        }
     }
 
     pub fn point(&self, v: u32) -> DVec3 {

@@ -193,6 +193,12 @@ impl<'a> Refiner<'a> {
     }
 
     fn refine_tet(&mut self, bad: Bad) -> Result<(), MeshError> {
+        // Shape bounds are not enforced next to acute input angles (the paper assumes none;
+        // enforcing them there splits the boundary without end). Size still is.
+        if bad.class != SIZE && bad.verts.iter().any(|&v| self.dom.near_acute(v)) {
+            self.gave_up += 1;
+            return Ok(());
+        }
         let [a, b, c, d] = self.dom.dt.tet_points(bad.tet);
         let q = Shape::of(a, b, c, d);
         let Some(centre) = q.circumcenter else {
