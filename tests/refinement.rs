@@ -176,3 +176,20 @@ fn progress_callback_can_cancel() {
     assert!(matches!(r, Err(slivermesh::refine::MeshError::Cancelled)));
     assert!(calls >= 1);
 }
+
+/// Models with small input angles: refinement terminates, and every tet away from the small
+/// angles meets the bounds (`complete`); the report counts the ones next to them that do not.
+#[test]
+fn acute_models_terminate_and_meet_bounds_away_from_small_angles() {
+    let params = Params::default();
+    for rel in ["off/star.off", "off/oblong.off"] {
+        let input = read_model(rel);
+        let (m, report) = mesh(&input, &params, None, None).unwrap_or_else(|e| panic!("{rel}: {e}"));
+        assert!(report.complete, "{rel}: {:?}", report.stop_reason);
+        check_orientation(&m);
+        check_boundary_faces_are_tet_faces(&m);
+        let want: f64 = facet_area_by_marker(&input).values().sum();
+        let got: f64 = boundary_area_by_marker(&m).values().sum();
+        assert!(rel_close(got, want, 1e-9), "{rel}: boundary area {got}, facets {want}");
+    }
+}

@@ -180,9 +180,12 @@ impl<'a> Refiner<'a> {
                 return Err(MeshError::Cancelled);
             }
             let gave_up = self.gave_up;
+            let before = self.dom.dt.num_vertices();
             self.refine_tet(bad)?;
-            // A boundary split need not destroy the tet that asked for it: look again.
+            // A boundary split need not destroy the tet that asked for it: look again (only
+            // if something was inserted, or it would come back forever).
             if self.gave_up == gave_up
+                && self.dom.dt.num_vertices() > before
                 && self.dom.dt.is_alive(bad.tet)
                 && self.dom.dt.tet(bad.tet) == bad.verts
             {
