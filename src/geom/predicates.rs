@@ -8,6 +8,52 @@
 //!
 //! Predicates are exact for finite inputs whose magnitudes lie in [`MIN_COORD`, `MAX_COORD`]
 //! (or are zero); [`check_coordinate`] enforces that range at the API boundary.
+//!
+//! # Semi-static filters
+//!
+//! [`orient3d`] and [`insphere`] first evaluate Shewchuk's determinant expressions in plain
+//! `f64` (no FMA: Rust never contracts) and return that value when its magnitude exceeds an
+//! error bound `eps`; otherwise they call robust's adaptive (exact) predicate. The bound is
+//! computed per call from the largest coordinate differences per axis (as CGAL's
+//! `Static_filters` do), so it adapts to the scale of the input.
+//!
+//! **Derivation.** Let `u = 2^-53` (unit roundoff, round to nearest). Let `X`, `Y`, `Z` be the
+//! largest magnitudes of the *computed* x-, y-, z-differences (for orient3d the three
+//! differences `a-d, b-d, c-d`; for insphere the four `·-e`), `M = max(X, Y, Z)`. For every
+//! computed quantity `q̂` (exact value `q`) track `|q| <= S·m` and `|q̂ - q| <= E·m` where `m`
+//! is the quantity's monomial in the maxima: a difference has `m = X` (or Y, Z), a 2x2 minor
+//! `XY`, a 3x3 term `XYZ`, a lift `x²+y²+z²` is bounded with `m = M²`, insphere's determinant
+//! has `m = XYZ·M²`. The rules (standard model, `|fl(x) - x| <= u·|fl(x)|` and `<= u·|x|`):
+//!
+//! * difference `d̂ = fl(p - q)` (an input to the rest): `E = u`, `S = 1 + u` (as `|d̂| <= m`);
+//!   a difference that is subnormal is exact.
+//! * sum `fl(â ± b̂)`: `E = Ea + Eb + u·(Sa + Ea + Sb + Eb)`, `S = Sa + Sb` (a subnormal sum is
+//!   exact, so underflow adds nothing).
+//! * product `fl(â·b̂)`: `|â b̂ - a b| <= |â|·|b̂ - b| + |b|·|â - a|` and the rounding adds
+//!   `u·|â b̂| + η` where `η = 2^-1075` covers a subnormal result. We require `min(X, Y, Z) >=
+//!   2^-190` ([`FILTER_MIN`]) so every monomial (degree <= 5, all maxima <= 1 worst case) is at
+//!   least `2^-950 >= η / u`: then `η <= u·m`, and
+//!   `E = (Sa + Ea)·Eb + Sb·Ea + u·(Sa + Ea)(Sb + Eb) + u`, `S = Sa·Sb`.
+//!
+//! Propagating exactly (rational arithmetic in `u`) through the evaluation order used below
+//! (minors `x·y - x·y`; terms `(z·m1 - z·m2) + z·m3`; lifts `(x·x + y·y) + z·z`; insphere
+//! `(l·t - l·t) + (l·t - l·t)`; orient3d `(z·m1 + z·m2) + z·m3`) gives
+//!
+//! * orient3d: `|det̂ - det| <= 55.00000000000004·u·XYZ`,
+//! * insphere: `|det̂ - det| <= 1288.000000000002·u·XYZ·M²`.
+//!
+//! (Same order as CGAL's generated bounds, 5.11e-15 and 1.2466e-13, for their evaluation
+//! orders; ours are 6.11e-15 and 1.43e-13.) The bound itself is evaluated in floating point as
+//! `((((C·X)·Y)·Z)·M)·M`, which can only lose a factor `(1 - u)^5`; the constants are rounded
+//! up to `56·u` ([`ORIENT3D_EPS`]) and `1289·u` ([`INSPHERE_EPS`]), which covers that. With
+//! `FILTER_MIN = 2^-190` every product in the bound is a normal number (`C·2^-950 > 2^-1022`);
+//! with `M <= 2^190` ([`FILTER_MAX`]) no intermediate can overflow (each is below
+//! `73·M^5 < 2^960`). When `|det̂| > eps` the sign of `det̂` is the sign of `det`. Otherwise
+//! (or when the maxima leave `[FILTER_MIN, FILTER_MAX]`, or for NaN, where every comparison is
+//! false) the exact predicate decides. One more exact shortcut: if the differences along one
+//! axis are all exactly zero, every term of the expansion has a zero factor, so the
+//! determinant is exactly zero. The bounds are re-derived by a test (`filter_bounds_derivation`)
+//! and the filters are checked against robust on near-degenerate inputs.
 
 use glam::DVec3;
 use std::cmp::Ordering;
@@ -17,6 +63,17 @@ use std::cmp::Ordering;
 pub const MAX_COORD: f64 = 1e30;
 /// Smallest accepted non-zero coordinate magnitude (degree-5 products must not underflow).
 pub const MIN_COORD: f64 = 1e-30;
+
+/// Unit roundoff of `f64` (round to nearest): 2^-53.
+const U: f64 = 1.0 / 9_007_199_254_740_992.0;
+/// Static-filter error coefficient of [`orient3d`] (see the module notes): `56·u`.
+pub const ORIENT3D_EPS: f64 = 56.0 * U;
+/// Static-filter error coefficient of [`insphere`] (see the module notes): `1289·u`.
+pub const INSPHERE_EPS: f64 = 1289.0 * U;
+/// Smallest per-axis difference maximum for which the filters are valid (underflow): 2^-190.
+pub const FILTER_MIN: f64 = 6.372_367_644_529_809e-58;
+/// Largest difference magnitude for which the filters are valid (overflow): 2^190.
+pub const FILTER_MAX: f64 = 1.569_275_433_846_670_2e57;
 
 #[inline(always)]
 fn c3(p: DVec3) -> robust::Coord3D<f64> {
@@ -28,18 +85,111 @@ fn c3(p: DVec3) -> robust::Coord3D<f64> {
 }
 
 /// Exact sign-valued orientation: > 0 if (a,b,c,d) is positively oriented, 0 if coplanar.
+///
+/// A semi-static floating-point filter (see [the filter notes](self#semi-static-filters))
+/// decides almost every call; the rest go to robust's adaptive predicate. The value is
+/// `det[b-a, c-a, d-a]` up to a small relative error; its sign is exact.
 #[inline]
 pub fn orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
+    match orient3d_filter(a, b, c, d) {
+        Some(v) => v,
+        None => orient3d_exact(a, b, c, d),
+    }
+}
+
+/// The semi-static filter of [`orient3d`]: `Some(value)` when it decides the sign.
+#[inline(always)]
+fn orient3d_filter(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Option<f64> {
+    // Shewchuk's orient3d evaluation (pa, pb, pc, pd) = (a, b, c, d); its sign is the
+    // opposite of ours, so the result is negated.
+    let (adx, bdx, cdx) = (a.x - d.x, b.x - d.x, c.x - d.x);
+    let (ady, bdy, cdy) = (a.y - d.y, b.y - d.y, c.y - d.y);
+    let (adz, bdz, cdz) = (a.z - d.z, b.z - d.z, c.z - d.z);
+    let det = adz * (bdx * cdy - cdx * bdy)
+        + bdz * (cdx * ady - adx * cdy)
+        + cdz * (adx * bdy - bdx * ady);
+    let mx = adx.abs().max(bdx.abs()).max(cdx.abs());
+    let my = ady.abs().max(bdy.abs()).max(cdy.abs());
+    let mz = adz.abs().max(bdz.abs()).max(cdz.abs());
+    let lo = mx.min(my).min(mz);
+    let hi = mx.max(my).max(mz);
+    if lo >= FILTER_MIN && hi <= FILTER_MAX {
+        let eps = ORIENT3D_EPS * mx * my * mz;
+        if det > eps || det < -eps {
+            return Some(-det);
+        }
+    } else if lo == 0.0 && det == 0.0 {
+        // All differences along one axis are exactly zero: every term of the determinant has
+        // a factor from each axis, so it is exactly zero. (det == 0 rules out NaN and inf.)
+        return Some(0.0);
+    }
+    None
+}
+
+#[cold]
+#[inline(never)]
+fn orient3d_exact(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
     // robust's orient3d is positive when d lies *below* the plane of counter-clockwise abc,
     // i.e. negative for a right-handed tet: negate to get our convention.
     -robust::orient3d(c3(a), c3(b), c3(c), c3(d))
 }
 
 /// Exact in-sphere test for a positively oriented tet (a,b,c,d): > 0 iff e is strictly inside.
+///
+/// Filtered like [`orient3d`]; the value is the lifted 4x4 determinant up to a small relative
+/// error, its sign is exact.
 #[inline]
 pub fn insphere(a: DVec3, b: DVec3, c: DVec3, d: DVec3, e: DVec3) -> f64 {
-    // robust's insphere expects its own positive orientation (our negative one) and then returns
-    // > 0 for inside. Swapping a and b turns our positive tet into robust's positive tet.
+    match insphere_filter(a, b, c, d, e) {
+        Some(v) => v,
+        None => insphere_exact(a, b, c, d, e),
+    }
+}
+
+/// The semi-static filter of [`insphere`]: `Some(value)` when it decides the sign.
+#[inline(always)]
+fn insphere_filter(a: DVec3, b: DVec3, c: DVec3, d: DVec3, e: DVec3) -> Option<f64> {
+    // Shewchuk's insphere evaluation with (pa, pb, pc, pd, pe) = (b, a, c, d, e): robust's
+    // insphere expects its own positive orientation (our negative one); swapping a and b
+    // turns our positive tet into robust's positive tet, and then > 0 means inside.
+    let (aex, bex, cex, dex) = (b.x - e.x, a.x - e.x, c.x - e.x, d.x - e.x);
+    let (aey, bey, cey, dey) = (b.y - e.y, a.y - e.y, c.y - e.y, d.y - e.y);
+    let (aez, bez, cez, dez) = (b.z - e.z, a.z - e.z, c.z - e.z, d.z - e.z);
+    let ab = aex * bey - bex * aey;
+    let bc = bex * cey - cex * bey;
+    let cd = cex * dey - dex * cey;
+    let da = dex * aey - aex * dey;
+    let ac = aex * cey - cex * aey;
+    let bd = bex * dey - dex * bey;
+    let abc = aez * bc - bez * ac + cez * ab;
+    let bcd = bez * cd - cez * bd + dez * bc;
+    let cda = cez * da + dez * ac + aez * cd;
+    let dab = dez * ab + aez * bd + bez * da;
+    let alift = aex * aex + aey * aey + aez * aez;
+    let blift = bex * bex + bey * bey + bez * bez;
+    let clift = cex * cex + cey * cey + cez * cez;
+    let dlift = dex * dex + dey * dey + dez * dez;
+    let det = (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
+    let mx = aex.abs().max(bex.abs()).max(cex.abs()).max(dex.abs());
+    let my = aey.abs().max(bey.abs()).max(cey.abs()).max(dey.abs());
+    let mz = aez.abs().max(bez.abs()).max(cez.abs()).max(dez.abs());
+    let lo = mx.min(my).min(mz);
+    let hi = mx.max(my).max(mz);
+    if lo >= FILTER_MIN && hi <= FILTER_MAX {
+        let eps = INSPHERE_EPS * mx * my * mz * hi * hi;
+        if det > eps || det < -eps {
+            return Some(det);
+        }
+    } else if lo == 0.0 && det == 0.0 {
+        // Every term holds one x, one y and one z difference (times a lift): exactly zero.
+        return Some(0.0);
+    }
+    None
+}
+
+#[cold]
+#[inline(never)]
+fn insphere_exact(a: DVec3, b: DVec3, c: DVec3, d: DVec3, e: DVec3) -> f64 {
     robust::insphere(c3(b), c3(a), c3(c), c3(d), c3(e))
 }
 
@@ -191,6 +341,134 @@ mod tests {
             let in1 = insphere_sos([O, X, Y, Z], [r[0], r[1], r[2], r[3]], w, r[4]);
             let in2 = insphere_sos(t2, [r[4], r[2], r[1], r[3]], O, r[0]);
             assert_eq!(in1, in2, "ranks {r:?}");
+        }
+    }
+
+    /// Re-derives the filter constants by the propagation rules of the module notes.
+    #[test]
+    fn filter_bounds_derivation() {
+        assert_eq!(FILTER_MIN, 2f64.powi(-190));
+        assert_eq!(FILTER_MAX, 2f64.powi(190));
+        assert_eq!(U, 2f64.powi(-53));
+        // (S, E) per quantity, in units of its monomial.
+        type Q = (f64, f64);
+        let diff: Q = (1.0 + U, U);
+        let add = |a: Q, b: Q| (a.0 + b.0, a.1 + b.1 + U * (a.0 + a.1 + b.0 + b.1));
+        let mul = |a: Q, b: Q| {
+            (
+                a.0 * b.0,
+                (a.0 + a.1) * b.1 + b.0 * a.1 + U * (a.0 + a.1) * (b.0 + b.1) + U,
+            )
+        };
+        let minor = add(mul(diff, diff), mul(diff, diff));
+        let term = mul(diff, minor);
+        let orient = add(add(term, term), term);
+        let sq = mul(diff, diff);
+        let lift = add(add(sq, sq), sq);
+        let lt = mul(lift, add(add(term, term), term));
+        let ins = add(add(lt, lt), add(lt, lt));
+        // The evaluation of eps loses at most (1 - u)^5; keep a margin for this test's own
+        // rounding (relative 1e-12).
+        let shrink = (1.0 - U).powi(5) * (1.0 - 1e-12);
+        assert!(orient.1 / U < 55.001 && ORIENT3D_EPS * shrink > orient.1, "{orient:?}");
+        assert!(ins.1 / U < 1288.001 && INSPHERE_EPS * shrink > ins.1, "{ins:?}");
+    }
+
+    fn robust_orient(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
+        -robust::orient3d(c3(a), c3(b), c3(c), c3(d))
+    }
+    fn robust_insphere(a: DVec3, b: DVec3, c: DVec3, d: DVec3, e: DVec3) -> f64 {
+        robust::insphere(c3(b), c3(a), c3(c), c3(d), c3(e))
+    }
+
+    /// The filtered predicates give robust's signs, on random and on nearly degenerate inputs
+    /// (where the filter must hand over), at many scales and offsets.
+    #[test]
+    fn filters_agree_with_robust() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(42);
+        let (mut undecided, mut total, mut orient_undecided) = (0, 0, 0);
+        for iter in 0..200_000 {
+            let scale = [1.0, 1e-30, 1e30, 3e-20, 7e15, 1e-3][iter % 6];
+            let offset = [0.0, 1.0, -1e6, 0.5][(iter / 6) % 4] * scale;
+            let rnd = |rng: &mut rand_chacha::ChaCha8Rng| {
+                DVec3::new(rng.gen::<f64>(), rng.gen::<f64>(), rng.gen::<f64>()) * scale
+                    + DVec3::splat(offset)
+            };
+            let (a, b, c, mut d) = (rnd(&mut rng), rnd(&mut rng), rnd(&mut rng), rnd(&mut rng));
+            let kind = (iter / 24) % 4;
+            if kind == 1 {
+                // d (nearly) in the plane of a, b, c
+                let (s, t) = (rng.gen::<f64>(), rng.gen::<f64>());
+                d = a + (b - a) * s + (c - a) * t;
+            }
+            let e0 = rnd(&mut rng);
+            let mut e = e0;
+            if orient3d(a, b, c, d) != 0.0 && kind >= 2 {
+                // e (nearly) on the sphere through a, b, c, d
+                let (u, v, w) = (b - a, c - a, d - a);
+                let n = (u.cross(v) * w.length_squared()
+                    + v.cross(w) * u.length_squared()
+                    + w.cross(u) * v.length_squared())
+                    / (2.0 * u.dot(v.cross(w)));
+                let centre = a + n;
+                let dir = (e0 - centre).normalize();
+                e = centre + dir * n.length();
+                if kind == 3 {
+                    // snap to a coarse lattice: exact ties happen
+                    let g = scale / 8.0;
+                    e = (e / g).round() * g;
+                }
+            }
+            let o = orient3d(a, b, c, d);
+            assert_eq!(sign(o), sign(robust_orient(a, b, c, d)), "orient {a} {b} {c} {d}");
+            if orient3d_filter(a, b, c, d).is_none() {
+                orient_undecided += 1;
+            }
+            let (p, q) = if o < 0.0 { (b, a) } else { (a, b) };
+            if o != 0.0 {
+                let i = insphere(p, q, c, d, e);
+                let r = robust_insphere(p, q, c, d, e);
+                assert_eq!(sign(i), sign(r), "insphere {p} {q} {c} {d} {e}");
+                total += 1;
+                if insphere_filter(p, q, c, d, e).is_none() {
+                    undecided += 1;
+                }
+            }
+        }
+        // The near-degenerate cases must exercise the hand-over, and most cases must not.
+        assert!(
+            total > 100_000 && undecided > total / 10 && undecided < total / 2,
+            "{undecided} of {total}"
+        );
+        assert!(orient_undecided > 20_000, "{orient_undecided}");
+    }
+
+    #[test]
+    fn filters_on_integer_grids_and_tiny_differences() {
+        // Exact zeros (cospherical / coplanar lattice points) and differences near FILTER_MIN.
+        let g = |x: i32, y: i32, z: i32| DVec3::new(x as f64, y as f64, z as f64);
+        let pts: Vec<DVec3> = (0..64).map(|i| g(i % 4, (i / 4) % 4, i / 16)).collect();
+        for i in 0..pts.len() {
+            for j in (i * 7 % 5)..pts.len() {
+                let (a, b, c, d, e) = (pts[i], pts[j], pts[(i + 5) % 64], pts[(j + 11) % 64], pts[(i * 3 + j) % 64]);
+                assert_eq!(sign(orient3d(a, b, c, d)), sign(robust_orient(a, b, c, d)));
+                let (p, q) = if orient3d(a, b, c, d) < 0.0 { (b, a) } else { (a, b) };
+                if orient3d(a, b, c, d) != 0.0 {
+                    assert_eq!(
+                        sign(insphere(p, q, c, d, e)),
+                        sign(robust_insphere(p, q, c, d, e))
+                    );
+                }
+            }
+        }
+        for k in [-200, -191, -190, -189, -150] {
+            let s = 2f64.powi(k);
+            let (a, b, c, d) = (DVec3::ZERO, DVec3::X * s, DVec3::Y * s, DVec3::Z * s);
+            assert!(orient3d(a, b, c, d) > 0.0, "2^{k}");
+            assert!(insphere(a, b, c, d, DVec3::splat(0.25 * s)) > 0.0, "2^{k}");
+            assert!(insphere(a, b, c, d, DVec3::splat(2.0 * s)) < 0.0, "2^{k}");
+            assert_eq!(insphere(a, b, c, d, DVec3::splat(s)), 0.0, "2^{k}");
         }
     }
 
