@@ -7,8 +7,8 @@
 //! conflicting tets around the tet containing p; its boundary is star-shaped from p.
 
 use super::tables::FACE;
-use super::{Delaunay, Inserted, INFINITE, NO_TET};
-use crate::geom::{insphere, insphere_tie, orient3d};
+use super::{Delaunay, Inserted, Tet, INFINITE, NO_TET};
+use crate::geom::{insphere, insphere_tie, orient3d, InsphereFan};
 use glam::DVec3;
 use rustc_hash::FxHashMap;
 
@@ -19,7 +19,6 @@ pub(super) struct Scratch {
     cavity: Vec<u32>,
     /// Cavity boundary as (cavity tet, local face) pairs.
     boundary: Vec<(u32, u8)>,
-    stack: Vec<u32>,
     /// Boundary faces copied out before their tets are reused: vertices, outer neighbour ref,
     /// tag of the cavity tet that owned the face.
     faces: Vec<([u32; 3], u32, u32)>,
@@ -33,7 +32,6 @@ impl Scratch {
     pub(super) fn memory_bytes(&self) -> usize {
         self.cavity.capacity() * 4
             + self.boundary.capacity() * 8
-            + self.stack.capacity() * 4
             + self.faces.capacity() * 20
             + self.created.capacity() * 4
             + self.edges.capacity() * 12
@@ -137,28 +135,76 @@ impl Delaunay {
     }
 
     /// Grows the cavity of `p` from `start` (which must conflict) into the scratch buffers.
+    ///
+    /// Breadth-first, with the cavity list as the queue: when a tet joins the cavity its
+    /// neighbours' records and marks are prefetched, and they are usually in cache by the time
+    /// it is dequeued and they are tested.
     fn find_cavity(&mut self, p: DVec3, rank: u32, start: u32) {
         const INSIDE: u8 = 1;
         const OUTSIDE: u8 = 2;
         let mut s = std::mem::take(&mut self.scratch);
         s.cavity.clear();
         s.boundary.clear();
-        s.stack.clear();
         self.mark[start as usize] = INSIDE;
         s.cavity.push(start);
-        s.stack.push(start);
-        while let Some(t) = s.stack.pop() {
-            for i in 0..4 {
-                let n = self.tets[t as usize].n[i] >> 2;
+        let mut head = 0;
+        while head < s.cavity.len() {
+            let t = s.cavity[head];
+            head += 1;
+            let Tet { v, n: nb } = self.tets[t as usize];
+            if v.contains(&INFINITE) {
+                // A hull tet: the general test for each neighbour.
+                for (i, &r) in nb.iter().enumerate() {
+                    let n = r >> 2;
+                    let m = self.mark[n as usize];
+                    if m == INSIDE {
+                        continue;
+                    }
+                    if m != OUTSIDE {
+                        if self.in_conflict(n, p, rank) {
+                            self.mark[n as usize] = INSIDE;
+                            s.cavity.push(n);
+                            self.prefetch_neighbors(n);
+                            continue;
+                        }
+                        self.mark[n as usize] = OUTSIDE;
+                    }
+                    s.boundary.push((t, i as u8));
+                }
+                continue;
+            }
+            // A finite tet: the neighbour across face i is (face i reversed, apex); only its
+            // apex is a new point. Prefetch the apexes, then test with the shared fan.
+            let mut apex = [INFINITE; 4];
+            for (i, &r) in nb.iter().enumerate() {
+                let n = (r >> 2) as usize;
+                if self.mark[n] == 0 {
+                    apex[i] = self.tets[n].v[(r & 3) as usize];
+                    self.prefetch_point(apex[i]);
+                }
+            }
+            let fan = InsphereFan::new(v.map(|k| self.points[k as usize]), p);
+            for (i, &r) in nb.iter().enumerate() {
+                let n = r >> 2;
                 let m = self.mark[n as usize];
                 if m == INSIDE {
                     continue;
                 }
                 if m != OUTSIDE {
-                    if self.in_conflict(n, p, rank) {
+                    let f = FACE[i];
+                    let conflict = if apex[i] == INFINITE {
+                        self.in_conflict(n, p, rank)
+                    } else {
+                        let q = self.points[apex[i] as usize];
+                        match fan.across(f[0], f[1], f[2], q, p) {
+                            Some(det) => det > 0.0,
+                            None => self.finite_in_conflict(n, p, rank),
+                        }
+                    };
+                    if conflict {
                         self.mark[n as usize] = INSIDE;
                         s.cavity.push(n);
-                        s.stack.push(n);
+                        self.prefetch_neighbors(n);
                         continue;
                     }
                     self.mark[n as usize] = OUTSIDE;
@@ -174,6 +220,34 @@ impl Delaunay {
             self.mark[(self.tets[t as usize].n[i as usize] >> 2) as usize] = 0;
         }
         self.scratch = s;
+    }
+
+    /// Hints the coordinates of vertex `v` (any id, `INFINITE` included) into the cache.
+    #[inline(always)]
+    fn prefetch_point(&self, v: u32) {
+        #[cfg(target_arch = "x86_64")]
+        unsafe {
+            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+            // wrapping: the address is only a hint, never dereferenced
+            let ptr = self.points.as_ptr().wrapping_add(v as usize) as *const i8;
+            _mm_prefetch(ptr, _MM_HINT_T0);
+            _mm_prefetch(ptr.wrapping_add(16), _MM_HINT_T0);
+        }
+    }
+
+    /// Hints the records and marks of `t`'s neighbours into the cache.
+    #[inline(always)]
+    fn prefetch_neighbors(&self, t: u32) {
+        #[cfg(target_arch = "x86_64")]
+        unsafe {
+            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+            let nb = self.tets.get_unchecked(t as usize).n;
+            for r in nb {
+                let n = (r >> 2) as usize;
+                _mm_prefetch(self.tets.as_ptr().add(n) as *const i8, _MM_HINT_T0);
+                _mm_prefetch(self.mark.as_ptr().add(n) as *const i8, _MM_HINT_T0);
+            }
+        }
     }
 
     /// Replaces the cavity in the scratch buffers by the star of vertex `id`.

@@ -193,6 +193,77 @@ fn insphere_exact(a: DVec3, b: DVec3, c: DVec3, d: DVec3, e: DVec3) -> f64 {
     robust::insphere(c3(b), c3(a), c3(c), c3(d), c3(e))
 }
 
+/// The in-sphere filter of the four tets across the faces of one tet, sharing the work: the
+/// differences to `e`, the lifts and the 2x2 minors of the common tet's four points are
+/// computed once. [`InsphereFan::across`] evaluates *bit for bit* the same expression (and
+/// the same error bound) as [`insphere`]'s filter, so its decisions carry the same guarantee.
+#[derive(Clone, Copy, Debug)]
+pub struct InsphereFan {
+    d: [[f64; 3]; 4],
+    abs: [[f64; 3]; 4],
+    lift: [f64; 4],
+    /// `m[j][k] = d[j].x * d[k].y - d[k].x * d[j].y` (so `m[k][j] = -m[j][k]` exactly).
+    m: [[f64; 4]; 4],
+}
+
+impl InsphereFan {
+    /// Prepares the fan of the points `q` around the query point `e`.
+    #[inline(always)]
+    pub fn new(q: [DVec3; 4], e: DVec3) -> Self {
+        let d = q.map(|p| [p.x - e.x, p.y - e.y, p.z - e.z]);
+        let abs = d.map(|v| v.map(f64::abs));
+        let lift = d.map(|v| v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        let mut m = [[0.0; 4]; 4];
+        for j in 0..4 {
+            for k in j + 1..4 {
+                let v = d[j][0] * d[k][1] - d[k][0] * d[j][1];
+                m[j][k] = v;
+                m[k][j] = -v;
+            }
+        }
+        InsphereFan { d, abs, lift, m }
+    }
+
+    /// Filtered in-sphere of `e` for the tet `(q[b], q[a], q[c], apex)` (which must be
+    /// positively oriented): `Some(value)` exactly when `insphere`'s filter would decide, with
+    /// the same value; `None` means the exact predicate must decide.
+    #[inline(always)]
+    pub fn across(&self, a: usize, b: usize, c: usize, apex: DVec3, e: DVec3) -> Option<f64> {
+        // Shewchuk's insphere with (pa, pb, pc, pd, pe) = (q[a], q[b], q[c], apex, e).
+        let [aex, aey, aez] = self.d[a];
+        let [bex, bey, bez] = self.d[b];
+        let [cex, cey, cez] = self.d[c];
+        let (dex, dey, dez) = (apex.x - e.x, apex.y - e.y, apex.z - e.z);
+        let ab = self.m[a][b];
+        let bc = self.m[b][c];
+        let ac = self.m[a][c];
+        let cd = cex * dey - dex * cey;
+        let da = dex * aey - aex * dey;
+        let bd = bex * dey - dex * bey;
+        let abc = aez * bc - bez * ac + cez * ab;
+        let bcd = bez * cd - cez * bd + dez * bc;
+        let cda = cez * da + dez * ac + aez * cd;
+        let dab = dez * ab + aez * bd + bez * da;
+        let dlift = dex * dex + dey * dey + dez * dez;
+        let det = (dlift * abc - self.lift[c] * dab) + (self.lift[b] * cda - self.lift[a] * bcd);
+        let (sa, sb, sc) = (self.abs[a], self.abs[b], self.abs[c]);
+        let mx = sa[0].max(sb[0]).max(sc[0]).max(dex.abs());
+        let my = sa[1].max(sb[1]).max(sc[1]).max(dey.abs());
+        let mz = sa[2].max(sb[2]).max(sc[2]).max(dez.abs());
+        let lo = mx.min(my).min(mz);
+        let hi = mx.max(my).max(mz);
+        if lo >= FILTER_MIN && hi <= FILTER_MAX {
+            let eps = INSPHERE_EPS * mx * my * mz * hi * hi;
+            if det > eps || det < -eps {
+                return Some(det);
+            }
+        } else if lo == 0.0 && det == 0.0 {
+            return Some(0.0);
+        }
+        None
+    }
+}
+
 /// Sign of a float as an `Ordering` (predicate results are exact, so no tolerance).
 #[inline(always)]
 pub fn sign(x: f64) -> Ordering {
@@ -442,6 +513,27 @@ mod tests {
             "{undecided} of {total}"
         );
         assert!(orient_undecided > 20_000, "{orient_undecided}");
+    }
+
+    #[test]
+    fn insphere_fan_equals_the_filter_bit_for_bit() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let mut rnd = |s: f64| {
+            DVec3::new(rng.gen::<f64>(), rng.gen::<f64>(), rng.gen::<f64>()) * s
+        };
+        for it in 0..20_000 {
+            let s = [1.0, 1e-20, 1e20, 1e-56][it % 4];
+            let q = [rnd(s), rnd(s), rnd(s), rnd(s)];
+            let e = if it % 3 == 0 { q[it % 4] + rnd(s) * 1e-9 } else { rnd(s) };
+            let apex = if it % 5 == 0 { q[(it + 1) % 4] } else { rnd(s) };
+            let fan = InsphereFan::new(q, e);
+            for (a, b, c) in [(1, 3, 2), (0, 2, 3), (3, 1, 0), (0, 1, 2), (2, 1, 0)] {
+                let x = fan.across(a, b, c, apex, e);
+                let y = insphere_filter(q[b], q[a], q[c], apex, e);
+                assert_eq!(x.map(f64::to_bits), y.map(f64::to_bits), "{q:?} {apex} {e}");
+            }
+        }
     }
 
     #[test]
