@@ -7,10 +7,9 @@
 //! conflicting tets around the tet containing p; its boundary is star-shaped from p.
 
 use super::tables::FACE;
-use super::{Delaunay, Inserted, Tet, INFINITE, NO_TET};
+use super::{Delaunay, Inserted, Tet, DEAD, INFINITE};
 use crate::geom::{insphere, insphere_tie, orient3d, InsphereFan};
 use glam::DVec3;
-use rustc_hash::FxHashMap;
 
 /// Reusable buffers for cavity searches.
 #[derive(Debug, Clone, Default)]
@@ -25,7 +24,7 @@ pub(super) struct Scratch {
     /// Tets created by the last insertion.
     pub(super) created: Vec<u32>,
     /// Directed boundary edge -> face reference of the new tet that owns it.
-    edges: FxHashMap<u64, u32>,
+    edges: EdgeTable,
 }
 
 impl Scratch {
@@ -34,7 +33,7 @@ impl Scratch {
             + self.boundary.capacity() * 8
             + self.faces.capacity() * 20
             + self.created.capacity() * 4
-            + self.edges.capacity() * 12
+            + self.edges.memory_bytes()
     }
 }
 
@@ -251,6 +250,10 @@ impl Delaunay {
     }
 
     /// Replaces the cavity in the scratch buffers by the star of vertex `id`.
+    ///
+    /// The new tets reuse the cavity's slots first (then the free list, then fresh slots);
+    /// their mutual links are found by pairing each directed boundary edge with its reverse
+    /// in a small open-addressing table.
     fn fill_cavity(&mut self, id: u32) {
         let mut s = std::mem::take(&mut self.scratch);
         s.faces.clear();
@@ -260,14 +263,37 @@ impl Delaunay {
             let tag = self.tags.get(t as usize).copied().unwrap_or(0);
             s.faces.push((face, self.tets[t as usize].n[i as usize], tag));
         }
-        for &t in &s.cavity {
-            self.free_tet(t);
-        }
-        s.edges.clear();
+        let removed_ghosts = s
+            .cavity
+            .iter()
+            .filter(|&&t| self.tets[t as usize].v.contains(&INFINITE))
+            .count();
+        // Slots: the cavity's first, then the free list, then new ones.
+        let (nf, nc) = (s.faces.len(), s.cavity.len());
         s.created.clear();
-        for &(face, outer, tag) in &s.faces {
-            let t = self.alloc_tet([face[0], face[1], face[2], id]);
+        s.created.extend_from_slice(&s.cavity[..nf.min(nc)]);
+        for _ in nc..nf {
+            let t = match self.free.pop() {
+                Some(t) => t,
+                None => {
+                    self.tets.push(Tet::default());
+                    self.mark.push(0);
+                    if self.tags_enabled {
+                        self.tags.push(0);
+                    }
+                    (self.tets.len() - 1) as u32
+                }
+            };
             s.created.push(t);
+        }
+        for &t in s.cavity.iter().skip(nf) {
+            self.tets[t as usize].v = [DEAD; 4];
+            self.free.push(t);
+        }
+        s.edges.begin(nf);
+        let mut new_ghosts = 0;
+        for (&(face, outer, tag), &t) in s.faces.iter().zip(&s.created) {
+            self.tets[t as usize].v = [face[0], face[1], face[2], id];
             if self.tags_enabled {
                 self.tags[t as usize] = tag;
             }
@@ -279,31 +305,101 @@ impl Delaunay {
             for j in 0..3 {
                 let (a, b) = (face[(j + 1) % 3], face[(j + 2) % 3]);
                 let mine = t * 4 + j as u32;
-                match s.edges.remove(&edge_key(b, a)) {
-                    Some(other) => {
-                        self.set_neighbor(mine, other);
-                        self.set_neighbor(other, mine);
-                    }
-                    None => {
-                        s.edges.insert(edge_key(a, b), mine);
-                    }
+                if let Some(other) = s.edges.pair(a, b, mine) {
+                    self.set_neighbor(mine, other);
+                    self.set_neighbor(other, mine);
                 }
             }
             for v in face {
                 if v != INFINITE {
                     self.vertex_tet[v as usize] = t;
+                } else {
+                    new_ghosts += 1;
                 }
             }
-            self.vertex_tet[id as usize] = t;
-            self.last = t;
         }
-        debug_assert!(
-            s.edges.is_empty(),
-            "cavity boundary is not a closed surface"
-        );
-        debug_assert!(self.vertex_tet[id as usize] != NO_TET);
+        let last = *s.created.last().expect("a cavity has boundary faces");
+        self.vertex_tet[id as usize] = last;
+        self.last = last;
+        self.n_alive = self.n_alive + nf - nc;
+        self.n_ghost = self.n_ghost + new_ghosts - removed_ghosts;
+        debug_assert!(s.edges.is_empty(), "cavity boundary is not a closed surface");
         self.scratch = s;
     }
+}
+
+/// Directed boundary edges waiting for their reverse: open addressing with linear probing,
+/// invalidated wholesale per cavity by a generation stamp.
+#[derive(Debug, Clone, Default)]
+pub(super) struct EdgeTable {
+    keys: Vec<u64>,
+    vals: Vec<u32>,
+    stamp: Vec<u32>,
+    generation: u32,
+    shift: u32,
+    open: usize,
+}
+
+impl EdgeTable {
+    /// Starts a new cavity with `faces` boundary faces.
+    #[inline]
+    fn begin(&mut self, faces: usize) {
+        // At most 3 * faces / 2 edges wait at once: keep the load factor <= 3/16.
+        let want = (faces * 8).next_power_of_two().max(256);
+        if want > self.keys.len() {
+            self.keys = vec![0; want];
+            self.vals = vec![0; want];
+            self.stamp = vec![0; want];
+            self.generation = 0;
+            self.shift = 64 - want.trailing_zeros();
+        }
+        self.generation = self.generation.wrapping_add(1);
+        if self.generation == 0 {
+            self.stamp.fill(0);
+            self.generation = 1;
+        }
+        self.open = 0;
+    }
+
+    /// Registers directed edge `a -> b` owned by face reference `mine`, or, if the edge
+    /// `b -> a` is waiting, removes it and returns its owner.
+    #[inline]
+    fn pair(&mut self, a: u32, b: u32, mine: u32) -> Option<u32> {
+        let want = edge_key(b, a);
+        let mask = self.keys.len() - 1;
+        let mut slot = (edge_hash(a, b) >> self.shift) as usize;
+        loop {
+            if self.stamp[slot] != self.generation {
+                // Empty: b -> a is not waiting.
+                self.stamp[slot] = self.generation;
+                self.keys[slot] = edge_key(a, b);
+                self.vals[slot] = mine;
+                self.open += 1;
+                return None;
+            }
+            if self.keys[slot] == want {
+                // A matched entry stays as a tombstone that matches nothing (keys are unique).
+                self.keys[slot] = u64::MAX;
+                self.open -= 1;
+                return Some(self.vals[slot]);
+            }
+            slot = (slot + 1) & mask;
+        }
+    }
+
+    fn is_empty(&self) -> bool {
+        self.open == 0
+    }
+
+    fn memory_bytes(&self) -> usize {
+        self.keys.capacity() * 8 + self.vals.capacity() * 4 + self.stamp.capacity() * 4
+    }
+}
+
+/// Symmetric in (a, b), so an edge and its reverse probe from the same slot.
+#[inline]
+fn edge_hash(a: u32, b: u32) -> u64 {
+    ((a ^ b) as u64 | ((a.min(b) as u64) << 32)).wrapping_mul(0x9E37_79B9_7F4A_7C15)
 }
 
 #[inline]

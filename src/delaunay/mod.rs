@@ -447,15 +447,6 @@ impl Delaunay {
         }
     }
 
-    fn free_tet(&mut self, t: u32) {
-        self.n_alive -= 1;
-        if self.tets[t as usize].v.contains(&INFINITE) {
-            self.n_ghost -= 1;
-        }
-        self.tets[t as usize].v = [DEAD; 4];
-        self.free.push(t);
-    }
-
     /// Cheap xorshift for the walk's random first face.
     #[inline]
     fn next_random(&mut self) -> u32 {
