@@ -301,14 +301,9 @@ impl Delaunay {
             self.set_neighbor(me, outer);
             self.set_neighbor(outer, me);
             // Face j (j < 3) holds the new vertex and the boundary edge face[j+1] -> face[j+2];
-            // the neighbouring boundary face runs along that edge the other way.
+            // register it, then (second pass) pair it with the reverse edge.
             for j in 0..3 {
-                let (a, b) = (face[(j + 1) % 3], face[(j + 2) % 3]);
-                let mine = t * 4 + j as u32;
-                if let Some(other) = s.edges.pair(a, b, mine) {
-                    self.set_neighbor(mine, other);
-                    self.set_neighbor(other, mine);
-                }
+                s.edges.insert(face[(j + 1) % 3], face[(j + 2) % 3], t * 4 + j as u32);
             }
             for v in face {
                 if v != INFINITE {
@@ -318,18 +313,26 @@ impl Delaunay {
                 }
             }
         }
+        // The neighbouring boundary face runs along each edge the other way. Each side writes
+        // its own link.
+        for (&(face, _, _), &t) in s.faces.iter().zip(&s.created) {
+            for j in 0..3 {
+                let other = s.edges.get(face[(j + 2) % 3], face[(j + 1) % 3]);
+                self.tets[t as usize].n[j] = other;
+            }
+        }
         let last = *s.created.last().expect("a cavity has boundary faces");
         self.vertex_tet[id as usize] = last;
         self.last = last;
         self.n_alive = self.n_alive + nf - nc;
         self.n_ghost = self.n_ghost + new_ghosts - removed_ghosts;
-        debug_assert!(s.edges.is_empty(), "cavity boundary is not a closed surface");
         self.scratch = s;
     }
 }
 
-/// Directed boundary edges waiting for their reverse: open addressing with linear probing,
-/// invalidated wholesale per cavity by a generation stamp.
+/// Directed boundary edges of a cavity and the new faces owning them: open addressing with
+/// linear probing, invalidated wholesale per cavity by a generation stamp. All edges are
+/// inserted first, then looked up, so the probes' branches are predictable.
 #[derive(Debug, Clone, Default)]
 pub(super) struct EdgeTable {
     keys: Vec<u64>,
@@ -337,15 +340,14 @@ pub(super) struct EdgeTable {
     stamp: Vec<u32>,
     generation: u32,
     shift: u32,
-    open: usize,
 }
 
 impl EdgeTable {
     /// Starts a new cavity with `faces` boundary faces.
     #[inline]
     fn begin(&mut self, faces: usize) {
-        // At most 3 * faces / 2 edges wait at once: keep the load factor <= 3/16.
-        let want = (faces * 8).next_power_of_two().max(256);
+        // 3 directed edges per face: keep the load factor <= 3/16.
+        let want = (faces * 16).next_power_of_two().max(512);
         if want > self.keys.len() {
             self.keys = vec![0; want];
             self.vals = vec![0; want];
@@ -358,37 +360,38 @@ impl EdgeTable {
             self.stamp.fill(0);
             self.generation = 1;
         }
-        self.open = 0;
     }
 
-    /// Registers directed edge `a -> b` owned by face reference `mine`, or, if the edge
-    /// `b -> a` is waiting, removes it and returns its owner.
+    /// Registers directed edge `a -> b` owned by face reference `val`.
     #[inline]
-    fn pair(&mut self, a: u32, b: u32, mine: u32) -> Option<u32> {
-        let want = edge_key(b, a);
+    fn insert(&mut self, a: u32, b: u32, val: u32) {
         let mask = self.keys.len() - 1;
         let mut slot = (edge_hash(a, b) >> self.shift) as usize;
+        while self.stamp[slot] == self.generation {
+            slot = (slot + 1) & mask;
+        }
+        self.stamp[slot] = self.generation;
+        self.keys[slot] = edge_key(a, b);
+        self.vals[slot] = val;
+    }
+
+    /// The owner of directed edge `a -> b`, which must have been registered (the cavity
+    /// boundary is a closed surface: every edge appears once in each direction).
+    #[inline]
+    fn get(&self, a: u32, b: u32) -> u32 {
+        let mask = self.keys.len() - 1;
+        let want = edge_key(a, b);
+        let mut slot = (edge_hash(a, b) >> self.shift) as usize;
         loop {
-            if self.stamp[slot] != self.generation {
-                // Empty: b -> a is not waiting.
-                self.stamp[slot] = self.generation;
-                self.keys[slot] = edge_key(a, b);
-                self.vals[slot] = mine;
-                self.open += 1;
-                return None;
-            }
+            assert!(
+                self.stamp[slot] == self.generation,
+                "cavity boundary is not a closed surface"
+            );
             if self.keys[slot] == want {
-                // A matched entry stays as a tombstone that matches nothing (keys are unique).
-                self.keys[slot] = u64::MAX;
-                self.open -= 1;
-                return Some(self.vals[slot]);
+                return self.vals[slot];
             }
             slot = (slot + 1) & mask;
         }
-    }
-
-    fn is_empty(&self) -> bool {
-        self.open == 0
     }
 
     fn memory_bytes(&self) -> usize {
@@ -396,10 +399,9 @@ impl EdgeTable {
     }
 }
 
-/// Symmetric in (a, b), so an edge and its reverse probe from the same slot.
 #[inline]
 fn edge_hash(a: u32, b: u32) -> u64 {
-    ((a ^ b) as u64 | ((a.min(b) as u64) << 32)).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+    (edge_key(a, b) ^ (a as u64).rotate_left(17)).wrapping_mul(0x9E37_79B9_7F4A_7C15)
 }
 
 #[inline]
