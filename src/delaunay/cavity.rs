@@ -182,7 +182,14 @@ impl Delaunay {
                     self.prefetch_point(apex[i]);
                 }
             }
-            let fan = InsphereFan::new(v.map(|k| self.points[k as usize]), p);
+            let pts = &self.points;
+            let q = [
+                pts[v[0] as usize],
+                pts[v[1] as usize],
+                pts[v[2] as usize],
+                pts[v[3] as usize],
+            ];
+            let fan = InsphereFan::new(q, p);
             for (i, &r) in nb.iter().enumerate() {
                 let n = r >> 2;
                 let m = self.mark[n as usize];

@@ -210,9 +210,15 @@ impl InsphereFan {
     /// Prepares the fan of the points `q` around the query point `e`.
     #[inline(always)]
     pub fn new(q: [DVec3; 4], e: DVec3) -> Self {
-        let d = q.map(|p| [p.x - e.x, p.y - e.y, p.z - e.z]);
-        let abs = d.map(|v| v.map(f64::abs));
-        let lift = d.map(|v| v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        let mut d = [[0.0; 3]; 4];
+        let mut abs = [[0.0; 3]; 4];
+        let mut lift = [0.0; 4];
+        for k in 0..4 {
+            let v = [q[k].x - e.x, q[k].y - e.y, q[k].z - e.z];
+            d[k] = v;
+            abs[k] = [v[0].abs(), v[1].abs(), v[2].abs()];
+            lift[k] = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        }
         let mut m = [[0.0; 4]; 4];
         for j in 0..4 {
             for k in j + 1..4 {
