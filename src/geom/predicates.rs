@@ -64,6 +64,32 @@ pub const MAX_COORD: f64 = 1e30;
 /// Smallest accepted non-zero coordinate magnitude (degree-5 products must not underflow).
 pub const MIN_COORD: f64 = 1e-30;
 
+/// `max` for the filters' maxima: one `maxsd` (LLVM turns `if a > b { a } else { b }` into
+/// a mispredicting branch in places). Unlike `f64::max` it need not skip NaN operands: a NaN
+/// difference makes the determinant NaN, and a NaN determinant never passes the filter test.
+#[inline(always)]
+fn fmax(a: f64, b: f64) -> f64 {
+    #[cfg(target_arch = "x86_64")]
+    unsafe {
+        use std::arch::x86_64::{_mm_cvtsd_f64, _mm_max_sd, _mm_set_sd};
+        _mm_cvtsd_f64(_mm_max_sd(_mm_set_sd(a), _mm_set_sd(b)))
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    a.max(b)
+}
+
+/// `min` counterpart of [`fmax`].
+#[inline(always)]
+fn fmin(a: f64, b: f64) -> f64 {
+    #[cfg(target_arch = "x86_64")]
+    unsafe {
+        use std::arch::x86_64::{_mm_cvtsd_f64, _mm_min_sd, _mm_set_sd};
+        _mm_cvtsd_f64(_mm_min_sd(_mm_set_sd(a), _mm_set_sd(b)))
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    a.min(b)
+}
+
 /// Unit roundoff of `f64` (round to nearest): 2^-53.
 const U: f64 = 1.0 / 9_007_199_254_740_992.0;
 /// Static-filter error coefficient of [`orient3d`] (see the module notes): `56·u`.
@@ -108,11 +134,11 @@ fn orient3d_filter(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Option<f64> {
     let det = adz * (bdx * cdy - cdx * bdy)
         + bdz * (cdx * ady - adx * cdy)
         + cdz * (adx * bdy - bdx * ady);
-    let mx = adx.abs().max(bdx.abs()).max(cdx.abs());
-    let my = ady.abs().max(bdy.abs()).max(cdy.abs());
-    let mz = adz.abs().max(bdz.abs()).max(cdz.abs());
-    let lo = mx.min(my).min(mz);
-    let hi = mx.max(my).max(mz);
+    let mx = fmax(fmax(adx.abs(), bdx.abs()), cdx.abs());
+    let my = fmax(fmax(ady.abs(), bdy.abs()), cdy.abs());
+    let mz = fmax(fmax(adz.abs(), bdz.abs()), cdz.abs());
+    let lo = fmin(fmin(mx, my), mz);
+    let hi = fmax(fmax(mx, my), mz);
     if lo >= FILTER_MIN && hi <= FILTER_MAX {
         let eps = ORIENT3D_EPS * mx * my * mz;
         if det > eps || det < -eps {
@@ -170,11 +196,11 @@ fn insphere_filter(a: DVec3, b: DVec3, c: DVec3, d: DVec3, e: DVec3) -> Option<f
     let clift = cex * cex + cey * cey + cez * cez;
     let dlift = dex * dex + dey * dey + dez * dez;
     let det = (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
-    let mx = aex.abs().max(bex.abs()).max(cex.abs()).max(dex.abs());
-    let my = aey.abs().max(bey.abs()).max(cey.abs()).max(dey.abs());
-    let mz = aez.abs().max(bez.abs()).max(cez.abs()).max(dez.abs());
-    let lo = mx.min(my).min(mz);
-    let hi = mx.max(my).max(mz);
+    let mx = fmax(fmax(aex.abs(), bex.abs()), fmax(cex.abs(), dex.abs()));
+    let my = fmax(fmax(aey.abs(), bey.abs()), fmax(cey.abs(), dey.abs()));
+    let mz = fmax(fmax(aez.abs(), bez.abs()), fmax(cez.abs(), dez.abs()));
+    let lo = fmin(fmin(mx, my), mz);
+    let hi = fmax(fmax(mx, my), mz);
     if lo >= FILTER_MIN && hi <= FILTER_MAX {
         let eps = INSPHERE_EPS * mx * my * mz * hi * hi;
         if det > eps || det < -eps {
@@ -253,11 +279,11 @@ impl InsphereFan {
         let dlift = dex * dex + dey * dey + dez * dez;
         let det = (dlift * abc - self.lift[c] * dab) + (self.lift[b] * cda - self.lift[a] * bcd);
         let (sa, sb, sc) = (self.abs[a], self.abs[b], self.abs[c]);
-        let mx = sa[0].max(sb[0]).max(sc[0]).max(dex.abs());
-        let my = sa[1].max(sb[1]).max(sc[1]).max(dey.abs());
-        let mz = sa[2].max(sb[2]).max(sc[2]).max(dez.abs());
-        let lo = mx.min(my).min(mz);
-        let hi = mx.max(my).max(mz);
+        let mx = fmax(fmax(sa[0], sb[0]), fmax(sc[0], dex.abs()));
+        let my = fmax(fmax(sa[1], sb[1]), fmax(sc[1], dey.abs()));
+        let mz = fmax(fmax(sa[2], sb[2]), fmax(sc[2], dez.abs()));
+        let lo = fmin(fmin(mx, my), mz);
+        let hi = fmax(fmax(mx, my), mz);
         if lo >= FILTER_MIN && hi <= FILTER_MAX {
             let eps = INSPHERE_EPS * mx * my * mz * hi * hi;
             if det > eps || det < -eps {
