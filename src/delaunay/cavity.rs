@@ -141,6 +141,7 @@ impl Delaunay {
     fn find_cavity(&mut self, p: DVec3, rank: u32, start: u32) {
         const INSIDE: u8 = 1;
         const OUTSIDE: u8 = 2;
+        const _: () = assert!(OUTSIDE - 1 == INSIDE);
         let mut s = std::mem::take(&mut self.scratch);
         s.cavity.clear();
         s.boundary.clear();
@@ -174,13 +175,12 @@ impl Delaunay {
             }
             // A finite tet: the neighbour across face i is (face i reversed, apex); only its
             // apex is a new point. Prefetch the apexes, then test with the shared fan.
+            // (Loaded unconditionally: a branch on the mark here mispredicts often, and the
+            // records of marked neighbours are in cache anyway.)
             let mut apex = [INFINITE; 4];
             for (i, &r) in nb.iter().enumerate() {
-                let n = (r >> 2) as usize;
-                if self.mark[n] == 0 {
-                    apex[i] = self.tets[n].v[(r & 3) as usize];
-                    self.prefetch_point(apex[i]);
-                }
+                apex[i] = self.tets[(r >> 2) as usize].v[(r & 3) as usize];
+                self.prefetch_point(apex[i]);
             }
             let pts = &self.points;
             let q = [
@@ -190,13 +190,12 @@ impl Delaunay {
                 pts[v[3] as usize],
             ];
             let fan = InsphereFan::new(q, p);
+            s.cavity.reserve(4);
+            s.boundary.reserve(4);
             for (i, &r) in nb.iter().enumerate() {
                 let n = r >> 2;
                 let m = self.mark[n as usize];
-                if m == INSIDE {
-                    continue;
-                }
-                if m != OUTSIDE {
+                let (inside, boundary) = if m == 0 {
                     let f = FACE[i];
                     let conflict = if apex[i] == INFINITE {
                         self.in_conflict(n, p, rank)
@@ -207,15 +206,22 @@ impl Delaunay {
                             None => self.finite_in_conflict(n, p, rank),
                         }
                     };
-                    if conflict {
-                        self.mark[n as usize] = INSIDE;
-                        s.cavity.push(n);
-                        self.prefetch_neighbors(n);
-                        continue;
-                    }
-                    self.mark[n as usize] = OUTSIDE;
+                    self.mark[n as usize] = OUTSIDE - conflict as u8;
+                    self.prefetch_neighbors(n);
+                    (conflict, !conflict)
+                } else {
+                    (false, m == OUTSIDE)
+                };
+                // Branch-free pushes: write the slot, advance the length by the condition.
+                // SAFETY: capacity for 4 more of each was reserved above.
+                unsafe {
+                    let len = s.cavity.len();
+                    s.cavity.as_mut_ptr().add(len).write(n);
+                    s.cavity.set_len(len + inside as usize);
+                    let len = s.boundary.len();
+                    s.boundary.as_mut_ptr().add(len).write((t, i as u8));
+                    s.boundary.set_len(len + boundary as usize);
                 }
-                s.boundary.push((t, i as u8));
             }
         }
         // Leave every mark at zero for the next search.
