@@ -7,7 +7,7 @@
 //! conflicting tets around the tet containing p; its boundary is star-shaped from p.
 
 use super::tables::FACE;
-use super::{Delaunay, Inserted, Tet, DEAD, INFINITE};
+use super::{has_infinite, Delaunay, Inserted, Tet, DEAD, INFINITE};
 use crate::geom::{insphere, insphere_tie, orient3d, InsphereFan};
 use glam::DVec3;
 
@@ -152,7 +152,7 @@ impl Delaunay {
             let t = s.cavity[head];
             head += 1;
             let Tet { v, n: nb } = self.tets[t as usize];
-            if v.contains(&INFINITE) {
+            if has_infinite(v) {
                 // A hull tet: the general test for each neighbour.
                 for (i, &r) in nb.iter().enumerate() {
                     let n = r >> 2;
@@ -279,7 +279,7 @@ impl Delaunay {
         let removed_ghosts = s
             .cavity
             .iter()
-            .filter(|&&t| self.tets[t as usize].v.contains(&INFINITE))
+            .filter(|&&t| has_infinite(self.tets[t as usize].v))
             .count();
         // Slots: the cavity's first, then the free list, then new ones.
         let (nf, nc) = (s.faces.len(), s.cavity.len());

@@ -229,7 +229,7 @@ impl Delaunay {
     }
     /// Whether alive tet `t` is finite (carries no infinite vertex).
     pub fn is_finite(&self, t: u32) -> bool {
-        !self.tets[t as usize].v.contains(&INFINITE)
+        !has_infinite(self.tets[t as usize].v)
     }
     /// Vertex ids of tet `t` (positively oriented if finite).
     pub fn tet(&self, t: u32) -> [u32; 4] {
@@ -457,6 +457,13 @@ impl Delaunay {
         self.rng = x;
         x
     }
+}
+
+/// Whether a tet's vertex list holds the infinite vertex (branch-free: `INFINITE` is the
+/// largest id, and dead slots never reach here).
+#[inline(always)]
+fn has_infinite(v: [u32; 4]) -> bool {
+    v[0].max(v[1]).max(v[2].max(v[3])) == INFINITE
 }
 
 /// Exact collinearity: the three points are collinear iff all three coordinate-plane

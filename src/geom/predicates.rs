@@ -141,7 +141,7 @@ fn orient3d_filter(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Option<f64> {
     let hi = fmax(fmax(mx, my), mz);
     if lo >= FILTER_MIN && hi <= FILTER_MAX {
         let eps = ORIENT3D_EPS * mx * my * mz;
-        if det > eps || det < -eps {
+        if det.abs() > eps {
             return Some(-det);
         }
     } else if lo == 0.0 && det == 0.0 {
@@ -203,7 +203,7 @@ fn insphere_filter(a: DVec3, b: DVec3, c: DVec3, d: DVec3, e: DVec3) -> Option<f
     let hi = fmax(fmax(mx, my), mz);
     if lo >= FILTER_MIN && hi <= FILTER_MAX {
         let eps = INSPHERE_EPS * mx * my * mz * hi * hi;
-        if det > eps || det < -eps {
+        if det.abs() > eps {
             return Some(det);
         }
     } else if lo == 0.0 && det == 0.0 {
@@ -286,7 +286,7 @@ impl InsphereFan {
         let hi = fmax(fmax(mx, my), mz);
         if lo >= FILTER_MIN && hi <= FILTER_MAX {
             let eps = INSPHERE_EPS * mx * my * mz * hi * hi;
-            if det > eps || det < -eps {
+            if det.abs() > eps {
                 return Some(det);
             }
         } else if lo == 0.0 && det == 0.0 {
