@@ -16,13 +16,12 @@ use glam::DVec3;
 pub(super) struct Scratch {
     /// Tets in conflict.
     cavity: Vec<u32>,
-    /// Cavity boundary as (cavity tet, local face) pairs.
-    boundary: Vec<(u32, u8)>,
-    /// Boundary faces copied out before their tets are reused: vertices, outer neighbour ref,
-    /// tag of the cavity tet that owned the face.
-    faces: Vec<([u32; 3], u32, u32)>,
+    /// Cavity boundary faces.
+    boundary: Vec<BoundaryFace>,
     /// Tets created by the last insertion.
     pub(super) created: Vec<u32>,
+    /// Tags of the boundary faces' owners (when tags are enabled).
+    tags: Vec<u32>,
     /// Directed boundary edge -> face reference of the new tet that owns it.
     edges: EdgeTable,
 }
@@ -30,11 +29,21 @@ pub(super) struct Scratch {
 impl Scratch {
     pub(super) fn memory_bytes(&self) -> usize {
         self.cavity.capacity() * 4
-            + self.boundary.capacity() * 8
-            + self.faces.capacity() * 20
+            + self.boundary.capacity() * std::mem::size_of::<BoundaryFace>()
             + self.created.capacity() * 4
+            + self.tags.capacity() * 4
             + self.edges.memory_bytes()
     }
+}
+
+/// A face of the cavity boundary, copied out of the cavity tet that owns it (so the slot can
+/// be reused): its vertices as seen from inside the cavity (`FACE` order of the owner), the
+/// reference to the outer neighbour's face, and the owner.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct BoundaryFace {
+    v: [u32; 3],
+    outer: u32,
+    owner: u32,
 }
 
 /// What inserting a point would do, computed without changing the triangulation.
@@ -76,15 +85,7 @@ impl Delaunay {
         }
         // The would-be vertex ranks above every existing one, as a real insertion would.
         self.find_cavity(p, self.points.len() as u32, start);
-        let faces = self
-            .scratch
-            .boundary
-            .iter()
-            .map(|&(t, i)| {
-                let v = self.tets[t as usize].v;
-                FACE[i as usize].map(|k| v[k])
-            })
-            .collect();
+        let faces = self.scratch.boundary.iter().map(|f| f.v).collect();
         DryRun::Cavity {
             removed: self.scratch.cavity.clone(),
             faces,
@@ -151,25 +152,31 @@ impl Delaunay {
         while head < s.cavity.len() {
             let t = s.cavity[head];
             head += 1;
-            let Tet { v, n: nb } = self.tets[t as usize];
+            let Tet { v, n: nb } = *self.tet_ref(t);
+            s.cavity.reserve(4);
+            s.boundary.reserve(4);
             if has_infinite(v) {
                 // A hull tet: the general test for each neighbour.
                 for (i, &r) in nb.iter().enumerate() {
                     let n = r >> 2;
-                    let m = self.mark[n as usize];
+                    let m = *self.mark_ref(n);
                     if m == INSIDE {
                         continue;
                     }
                     if m != OUTSIDE {
                         if self.in_conflict(n, p, rank) {
-                            self.mark[n as usize] = INSIDE;
+                            *self.mark_mut(n) = INSIDE;
                             s.cavity.push(n);
                             self.prefetch_neighbors(n);
                             continue;
                         }
-                        self.mark[n as usize] = OUTSIDE;
+                        *self.mark_mut(n) = OUTSIDE;
                     }
-                    s.boundary.push((t, i as u8));
+                    s.boundary.push(BoundaryFace {
+                        v: FACE[i].map(|k| v[k]),
+                        outer: r,
+                        owner: t,
+                    });
                 }
                 continue;
             }
@@ -179,34 +186,30 @@ impl Delaunay {
             // records of marked neighbours are in cache anyway.)
             let mut apex = [INFINITE; 4];
             for (i, &r) in nb.iter().enumerate() {
-                apex[i] = self.tets[(r >> 2) as usize].v[(r & 3) as usize];
+                apex[i] = self.tet_ref(r >> 2).v[(r & 3) as usize];
                 self.prefetch_point(apex[i]);
             }
-            let pts = &self.points;
             let q = [
-                pts[v[0] as usize],
-                pts[v[1] as usize],
-                pts[v[2] as usize],
-                pts[v[3] as usize],
+                self.point_ref(v[0]),
+                self.point_ref(v[1]),
+                self.point_ref(v[2]),
+                self.point_ref(v[3]),
             ];
             let fan = InsphereFan::new(q, p);
-            s.cavity.reserve(4);
-            s.boundary.reserve(4);
             for (i, &r) in nb.iter().enumerate() {
                 let n = r >> 2;
-                let m = self.mark[n as usize];
+                let m = *self.mark_ref(n);
                 let (inside, boundary) = if m == 0 {
                     let f = FACE[i];
                     let conflict = if apex[i] == INFINITE {
                         self.in_conflict(n, p, rank)
                     } else {
-                        let q = self.points[apex[i] as usize];
-                        match fan.across(f[0], f[1], f[2], q, p) {
+                        match fan.across(f[0], f[1], f[2], self.point_ref(apex[i]), p) {
                             Some(det) => det > 0.0,
                             None => self.finite_in_conflict(n, p, rank),
                         }
                     };
-                    self.mark[n as usize] = OUTSIDE - conflict as u8;
+                    *self.mark_mut(n) = OUTSIDE - conflict as u8;
                     self.prefetch_neighbors(n);
                     (conflict, !conflict)
                 } else {
@@ -219,17 +222,22 @@ impl Delaunay {
                     s.cavity.as_mut_ptr().add(len).write(n);
                     s.cavity.set_len(len + inside as usize);
                     let len = s.boundary.len();
-                    s.boundary.as_mut_ptr().add(len).write((t, i as u8));
+                    let face = BoundaryFace {
+                        v: FACE[i].map(|k| v[k]),
+                        outer: r,
+                        owner: t,
+                    };
+                    s.boundary.as_mut_ptr().add(len).write(face);
                     s.boundary.set_len(len + boundary as usize);
                 }
             }
         }
         // Leave every mark at zero for the next search.
         for &t in &s.cavity {
-            self.mark[t as usize] = 0;
+            *self.mark_mut(t) = 0;
         }
-        for &(t, i) in &s.boundary {
-            self.mark[(self.tets[t as usize].n[i as usize] >> 2) as usize] = 0;
+        for f in &s.boundary {
+            *self.mark_mut(f.outer >> 2) = 0;
         }
         self.scratch = s;
     }
@@ -253,8 +261,7 @@ impl Delaunay {
         #[cfg(target_arch = "x86_64")]
         unsafe {
             use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-            let nb = self.tets.get_unchecked(t as usize).n;
-            for r in nb {
+            for r in self.tet_ref(t).n {
                 let n = (r >> 2) as usize;
                 _mm_prefetch(self.tets.as_ptr().add(n) as *const i8, _MM_HINT_T0);
                 _mm_prefetch(self.mark.as_ptr().add(n) as *const i8, _MM_HINT_T0);
@@ -269,20 +276,13 @@ impl Delaunay {
     /// in a small open-addressing table.
     fn fill_cavity(&mut self, id: u32) {
         let mut s = std::mem::take(&mut self.scratch);
-        s.faces.clear();
-        for &(t, i) in &s.boundary {
-            let v = self.tets[t as usize].v;
-            let face = FACE[i as usize].map(|k| v[k]);
-            let tag = self.tags.get(t as usize).copied().unwrap_or(0);
-            s.faces.push((face, self.tets[t as usize].n[i as usize], tag));
-        }
         let removed_ghosts = s
             .cavity
             .iter()
-            .filter(|&&t| has_infinite(self.tets[t as usize].v))
+            .filter(|&&t| has_infinite(self.tet_ref(t).v))
             .count();
         // Slots: the cavity's first, then the free list, then new ones.
-        let (nf, nc) = (s.faces.len(), s.cavity.len());
+        let (nf, nc) = (s.boundary.len(), s.cavity.len());
         s.created.clear();
         s.created.extend_from_slice(&s.cavity[..nf.min(nc)]);
         for _ in nc..nf {
@@ -299,20 +299,28 @@ impl Delaunay {
             };
             s.created.push(t);
         }
+        // Tags of the owners, read before their slots are overwritten.
+        if self.tags_enabled {
+            s.tags.clear();
+            s.tags
+                .extend(s.boundary.iter().map(|f| self.tags[f.owner as usize]));
+        }
         for &t in s.cavity.iter().skip(nf) {
-            self.tets[t as usize].v = [DEAD; 4];
+            self.tet_mut(t).v = [DEAD; 4];
             self.free.push(t);
         }
         s.edges.begin(nf);
         let mut new_ghosts = 0;
-        for (&(face, outer, tag), &t) in s.faces.iter().zip(&s.created) {
-            self.tets[t as usize].v = [face[0], face[1], face[2], id];
+        for (k, (f, &t)) in s.boundary.iter().zip(&s.created).enumerate() {
+            let face = f.v;
+            *self.tet_mut(t) = Tet {
+                v: [face[0], face[1], face[2], id],
+                n: [0, 0, 0, f.outer],
+            };
             if self.tags_enabled {
-                self.tags[t as usize] = tag;
+                self.tags[t as usize] = s.tags[k];
             }
-            let me = t * 4 + 3;
-            self.set_neighbor(me, outer);
-            self.set_neighbor(outer, me);
+            self.tet_mut(f.outer >> 2).n[(f.outer & 3) as usize] = t * 4 + 3;
             // Face j (j < 3) holds the new vertex and the boundary edge face[j+1] -> face[j+2];
             // register it, then (second pass) pair it with the reverse edge.
             for j in 0..3 {
@@ -320,7 +328,9 @@ impl Delaunay {
             }
             for v in face {
                 if v != INFINITE {
-                    self.vertex_tet[v as usize] = t;
+                    debug_assert!((v as usize) < self.vertex_tet.len());
+                    // SAFETY: finite vertex ids of alive tets index the vertex arrays.
+                    unsafe { *self.vertex_tet.get_unchecked_mut(v as usize) = t };
                 } else {
                     new_ghosts += 1;
                 }
@@ -328,10 +338,11 @@ impl Delaunay {
         }
         // The neighbouring boundary face runs along each edge the other way. Each side writes
         // its own link.
-        for (&(face, _, _), &t) in s.faces.iter().zip(&s.created) {
+        for (f, &t) in s.boundary.iter().zip(&s.created) {
+            let face = f.v;
             for j in 0..3 {
                 let other = s.edges.get(face[(j + 2) % 3], face[(j + 1) % 3]);
-                self.tets[t as usize].n[j] = other;
+                self.tet_mut(t).n[j] = other;
             }
         }
         let last = *s.created.last().expect("a cavity has boundary faces");
@@ -380,12 +391,15 @@ impl EdgeTable {
     fn insert(&mut self, a: u32, b: u32, val: u32) {
         let mask = self.keys.len() - 1;
         let mut slot = (edge_hash(a, b) >> self.shift) as usize;
-        while self.stamp[slot] == self.generation {
-            slot = (slot + 1) & mask;
+        // SAFETY: slots are masked to the length of all three arrays (a power of two).
+        unsafe {
+            while *self.stamp.get_unchecked(slot) == self.generation {
+                slot = (slot + 1) & mask;
+            }
+            *self.stamp.get_unchecked_mut(slot) = self.generation;
+            *self.keys.get_unchecked_mut(slot) = edge_key(a, b);
+            *self.vals.get_unchecked_mut(slot) = val;
         }
-        self.stamp[slot] = self.generation;
-        self.keys[slot] = edge_key(a, b);
-        self.vals[slot] = val;
     }
 
     /// The owner of directed edge `a -> b`, which must have been registered (the cavity
@@ -395,15 +409,18 @@ impl EdgeTable {
         let mask = self.keys.len() - 1;
         let want = edge_key(a, b);
         let mut slot = (edge_hash(a, b) >> self.shift) as usize;
-        loop {
-            assert!(
-                self.stamp[slot] == self.generation,
-                "cavity boundary is not a closed surface"
-            );
-            if self.keys[slot] == want {
-                return self.vals[slot];
+        // SAFETY: slots are masked to the length of all three arrays (a power of two).
+        unsafe {
+            loop {
+                assert!(
+                    *self.stamp.get_unchecked(slot) == self.generation,
+                    "cavity boundary is not a closed surface"
+                );
+                if *self.keys.get_unchecked(slot) == want {
+                    return *self.vals.get_unchecked(slot);
+                }
+                slot = (slot + 1) & mask;
             }
-            slot = (slot + 1) & mask;
         }
     }
 

@@ -421,6 +421,42 @@ impl Delaunay {
         }
     }
 
+    // Unchecked accessors for the hot paths. Invariants: neighbour references of alive tets
+    // name existing slots (`tets` never shrinks), and finite vertex ids of alive tets index
+    // `points` (checked in debug builds).
+
+    #[inline(always)]
+    fn tet_ref(&self, t: u32) -> &Tet {
+        debug_assert!((t as usize) < self.tets.len());
+        // SAFETY: see the invariants above.
+        unsafe { self.tets.get_unchecked(t as usize) }
+    }
+    #[inline(always)]
+    fn tet_mut(&mut self, t: u32) -> &mut Tet {
+        debug_assert!((t as usize) < self.tets.len());
+        // SAFETY: see the invariants above.
+        unsafe { self.tets.get_unchecked_mut(t as usize) }
+    }
+    #[inline(always)]
+    fn mark_ref(&self, t: u32) -> &u8 {
+        debug_assert!((t as usize) < self.mark.len());
+        // SAFETY: `mark` has one entry per tet slot.
+        unsafe { self.mark.get_unchecked(t as usize) }
+    }
+    #[inline(always)]
+    fn mark_mut(&mut self, t: u32) -> &mut u8 {
+        debug_assert!((t as usize) < self.mark.len());
+        // SAFETY: `mark` has one entry per tet slot.
+        unsafe { self.mark.get_unchecked_mut(t as usize) }
+    }
+    /// Coordinates of a finite vertex of an alive tet.
+    #[inline(always)]
+    fn point_ref(&self, v: u32) -> DVec3 {
+        debug_assert!((v as usize) < self.points.len());
+        // SAFETY: see the invariants above.
+        unsafe { *self.points.get_unchecked(v as usize) }
+    }
+
     #[inline]
     fn set_neighbor(&mut self, from: u32, to: u32) {
         self.tets[(from >> 2) as usize].n[(from & 3) as usize] = to;
