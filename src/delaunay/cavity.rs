@@ -46,6 +46,11 @@ pub(super) struct BoundaryFace {
     owner: u32,
 }
 
+/// Cavity search marks (zero: not visited).
+const INSIDE: u8 = 1;
+const OUTSIDE: u8 = 2;
+const _: () = assert!(OUTSIDE - 1 == INSIDE);
+
 /// What inserting a point would do, computed without changing the triangulation.
 #[derive(Debug, Clone, PartialEq)]
 pub enum DryRun {
@@ -140,9 +145,6 @@ impl Delaunay {
     /// neighbours' records and marks are prefetched, and they are usually in cache by the time
     /// it is dequeued and they are tested.
     fn find_cavity(&mut self, p: DVec3, rank: u32, start: u32) {
-        const INSIDE: u8 = 1;
-        const OUTSIDE: u8 = 2;
-        const _: () = assert!(OUTSIDE - 1 == INSIDE);
         let mut s = std::mem::take(&mut self.scratch);
         s.cavity.clear();
         s.boundary.clear();
@@ -196,41 +198,11 @@ impl Delaunay {
                 self.point_ref(v[3]),
             ];
             let fan = InsphereFan::new(q, p);
-            for (i, &r) in nb.iter().enumerate() {
-                let n = r >> 2;
-                let m = *self.mark_ref(n);
-                let (inside, boundary) = if m == 0 {
-                    let f = FACE[i];
-                    let conflict = if apex[i] == INFINITE {
-                        self.in_conflict(n, p, rank)
-                    } else {
-                        match fan.across(f[0], f[1], f[2], self.point_ref(apex[i]), p) {
-                            Some(det) => det > 0.0,
-                            None => self.finite_in_conflict(n, p, rank),
-                        }
-                    };
-                    *self.mark_mut(n) = OUTSIDE - conflict as u8;
-                    self.prefetch_neighbors(n);
-                    (conflict, !conflict)
-                } else {
-                    (false, m == OUTSIDE)
-                };
-                // Branch-free pushes: write the slot, advance the length by the condition.
-                // SAFETY: capacity for 4 more of each was reserved above.
-                unsafe {
-                    let len = s.cavity.len();
-                    s.cavity.as_mut_ptr().add(len).write(n);
-                    s.cavity.set_len(len + inside as usize);
-                    let len = s.boundary.len();
-                    let face = BoundaryFace {
-                        v: FACE[i].map(|k| v[k]),
-                        outer: r,
-                        owner: t,
-                    };
-                    s.boundary.as_mut_ptr().add(len).write(face);
-                    s.boundary.set_len(len + boundary as usize);
-                }
-            }
+            // Unrolled (constant face indices let the fan's entries stay at fixed places).
+            self.test_face::<0>(&mut s, &fan, t, v, nb[0], apex[0], p, rank);
+            self.test_face::<1>(&mut s, &fan, t, v, nb[1], apex[1], p, rank);
+            self.test_face::<2>(&mut s, &fan, t, v, nb[2], apex[2], p, rank);
+            self.test_face::<3>(&mut s, &fan, t, v, nb[3], apex[3], p, rank);
         }
         // Leave every mark at zero for the next search.
         for &t in &s.cavity {
@@ -240,6 +212,57 @@ impl Delaunay {
             *self.mark_mut(f.outer >> 2) = 0;
         }
         self.scratch = s;
+    }
+
+    /// One neighbour of a dequeued finite cavity tet `t` (vertices `v`): the neighbour across
+    /// face `I` (reference `r`, apex `apex`) is tested if unmarked, and joins the cavity or
+    /// makes face `I` a boundary face.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn test_face<const I: usize>(
+        &mut self,
+        s: &mut Scratch,
+        fan: &InsphereFan,
+        t: u32,
+        v: [u32; 4],
+        r: u32,
+        apex: u32,
+        p: DVec3,
+        rank: u32,
+    ) {
+        let n = r >> 2;
+        let m = *self.mark_ref(n);
+        let f = FACE[I];
+        let (inside, boundary) = if m == 0 {
+            let conflict = if apex == INFINITE {
+                self.in_conflict(n, p, rank)
+            } else {
+                match fan.across(f[0], f[1], f[2], self.point_ref(apex), p) {
+                    Some(det) => det > 0.0,
+                    None => self.finite_in_conflict(n, p, rank),
+                }
+            };
+            *self.mark_mut(n) = OUTSIDE - conflict as u8;
+            self.prefetch_neighbors(n);
+            (conflict, !conflict)
+        } else {
+            (false, m == OUTSIDE)
+        };
+        // Branch-free pushes: write the slot, advance the length by the condition.
+        // SAFETY: the caller reserved capacity for 4 more of each.
+        unsafe {
+            let len = s.cavity.len();
+            s.cavity.as_mut_ptr().add(len).write(n);
+            s.cavity.set_len(len + inside as usize);
+            let len = s.boundary.len();
+            let face = BoundaryFace {
+                v: [v[f[0]], v[f[1]], v[f[2]]],
+                outer: r,
+                owner: t,
+            };
+            s.boundary.as_mut_ptr().add(len).write(face);
+            s.boundary.set_len(len + boundary as usize);
+        }
     }
 
     /// Hints the coordinates of vertex `v` (any id, `INFINITE` included) into the cache.
