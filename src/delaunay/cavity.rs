@@ -312,6 +312,7 @@ impl Delaunay {
             let t = match self.free.pop() {
                 Some(t) => t,
                 None => {
+                    self.grow_tets();
                     self.tets.push(Tet::default());
                     self.mark.push(0);
                     if self.tags_enabled {
