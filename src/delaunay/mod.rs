@@ -154,7 +154,7 @@ impl Delaunay {
             if first.contains(&id) {
                 continue;
             }
-            let hint = dt.last;
+            let hint = dt.hint_towards(dt.points[id as usize]);
             match dt.insert_vertex(id, hint) {
                 Inserted::New(_) => stats.inserted += 1,
                 Inserted::Duplicate(_) => stats.duplicates += 1,
@@ -179,7 +179,10 @@ impl Delaunay {
         self.points.push(p);
         self.vertex_tet.push(NO_TET);
         self.rank.push(index as u32);
-        let hint = hint.filter(|&t| self.is_alive(t)).unwrap_or(self.last);
+        let hint = match hint.filter(|&t| self.is_alive(t)) {
+            Some(t) => t,
+            None => self.hint_towards(p),
+        };
         let r = self.insert_vertex(index as u32, hint);
         if let Inserted::Duplicate(_) = r {
             self.points.pop();
