@@ -383,11 +383,19 @@ impl Delaunay {
 /// inserted first, then looked up, so the probes' branches are predictable.
 #[derive(Debug, Clone, Default)]
 pub(super) struct EdgeTable {
-    keys: Vec<u64>,
-    vals: Vec<u32>,
-    stamp: Vec<u32>,
+    slots: Vec<EdgeSlot>,
     generation: u32,
     shift: u32,
+}
+
+/// One slot: a directed edge, its owner, and the generation that wrote it (one 16-byte
+/// record, so a probe touches one cache line).
+#[derive(Debug, Clone, Copy, Default)]
+#[repr(C, align(16))]
+struct EdgeSlot {
+    key: u64,
+    val: u32,
+    stamp: u32,
 }
 
 impl EdgeTable {
@@ -396,16 +404,14 @@ impl EdgeTable {
     fn begin(&mut self, faces: usize) {
         // 3 directed edges per face: keep the load factor <= 3/16.
         let want = (faces * 16).next_power_of_two().max(512);
-        if want > self.keys.len() {
-            self.keys = vec![0; want];
-            self.vals = vec![0; want];
-            self.stamp = vec![0; want];
+        if want > self.slots.len() {
+            self.slots = vec![EdgeSlot::default(); want];
             self.generation = 0;
             self.shift = 64 - want.trailing_zeros();
         }
         self.generation = self.generation.wrapping_add(1);
         if self.generation == 0 {
-            self.stamp.fill(0);
+            self.slots.fill(EdgeSlot::default());
             self.generation = 1;
         }
     }
@@ -413,16 +419,18 @@ impl EdgeTable {
     /// Registers directed edge `a -> b` owned by face reference `val`.
     #[inline]
     fn insert(&mut self, a: u32, b: u32, val: u32) {
-        let mask = self.keys.len() - 1;
+        let mask = self.slots.len() - 1;
         let mut slot = (edge_hash(a, b) >> self.shift) as usize;
-        // SAFETY: slots are masked to the length of all three arrays (a power of two).
+        // SAFETY: slots are masked to the table length (a power of two).
         unsafe {
-            while *self.stamp.get_unchecked(slot) == self.generation {
+            while self.slots.get_unchecked(slot).stamp == self.generation {
                 slot = (slot + 1) & mask;
             }
-            *self.stamp.get_unchecked_mut(slot) = self.generation;
-            *self.keys.get_unchecked_mut(slot) = edge_key(a, b);
-            *self.vals.get_unchecked_mut(slot) = val;
+            *self.slots.get_unchecked_mut(slot) = EdgeSlot {
+                key: edge_key(a, b),
+                val,
+                stamp: self.generation,
+            };
         }
     }
 
@@ -430,18 +438,19 @@ impl EdgeTable {
     /// boundary is a closed surface: every edge appears once in each direction).
     #[inline]
     fn get(&self, a: u32, b: u32) -> u32 {
-        let mask = self.keys.len() - 1;
+        let mask = self.slots.len() - 1;
         let want = edge_key(a, b);
         let mut slot = (edge_hash(a, b) >> self.shift) as usize;
-        // SAFETY: slots are masked to the length of all three arrays (a power of two).
+        // SAFETY: slots are masked to the table length (a power of two).
         unsafe {
             loop {
+                let e = self.slots.get_unchecked(slot);
                 assert!(
-                    *self.stamp.get_unchecked(slot) == self.generation,
+                    e.stamp == self.generation,
                     "cavity boundary is not a closed surface"
                 );
-                if *self.keys.get_unchecked(slot) == want {
-                    return *self.vals.get_unchecked(slot);
+                if e.key == want {
+                    return e.val;
                 }
                 slot = (slot + 1) & mask;
             }
@@ -449,7 +458,7 @@ impl EdgeTable {
     }
 
     fn memory_bytes(&self) -> usize {
-        self.keys.capacity() * 8 + self.vals.capacity() * 4 + self.stamp.capacity() * 4
+        self.slots.capacity() * std::mem::size_of::<EdgeSlot>()
     }
 }
 
