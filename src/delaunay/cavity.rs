@@ -16,6 +16,8 @@ use glam::DVec3;
 pub(super) struct Scratch {
     /// Tets in conflict.
     cavity: Vec<u32>,
+    /// For each cavity tet, the local index of the face it was reached through (4: start).
+    entry: Vec<u8>,
     /// Cavity boundary faces.
     boundary: Vec<BoundaryFace>,
     /// Tets created by the last insertion.
@@ -29,6 +31,7 @@ pub(super) struct Scratch {
 impl Scratch {
     pub(super) fn memory_bytes(&self) -> usize {
         self.cavity.capacity() * 4
+            + self.entry.capacity()
             + self.boundary.capacity() * std::mem::size_of::<BoundaryFace>()
             + self.created.capacity() * 4
             + self.tags.capacity() * 4
@@ -147,15 +150,18 @@ impl Delaunay {
     fn find_cavity(&mut self, p: DVec3, rank: u32, start: u32) {
         let mut s = std::mem::take(&mut self.scratch);
         s.cavity.clear();
+        s.entry.clear();
         s.boundary.clear();
         self.mark[start as usize] = INSIDE;
         s.cavity.push(start);
+        s.entry.push(4);
         let mut head = 0;
         while head < s.cavity.len() {
             let t = s.cavity[head];
             head += 1;
             let Tet { v, n: nb } = *self.tet_ref(t);
             s.cavity.reserve(4);
+            s.entry.reserve(4);
             s.boundary.reserve(4);
             if has_infinite(v) {
                 // A hull tet: the general test for each neighbour.
@@ -169,6 +175,7 @@ impl Delaunay {
                         if self.in_conflict(n, p, rank) {
                             *self.mark_mut(n) = INSIDE;
                             s.cavity.push(n);
+                            s.entry.push((r & 3) as u8);
                             self.prefetch_neighbors(n);
                             continue;
                         }
@@ -183,26 +190,36 @@ impl Delaunay {
                 continue;
             }
             // A finite tet: the neighbour across face i is (face i reversed, apex); only its
-            // apex is a new point. Prefetch the apexes, then test with the shared fan.
-            // (Loaded unconditionally: a branch on the mark here mispredicts often, and the
-            // records of marked neighbours are in cache anyway.)
-            let mut apex = [INFINITE; 4];
-            for (i, &r) in nb.iter().enumerate() {
-                apex[i] = self.tet_ref(r >> 2).v[(r & 3) as usize];
-                self.prefetch_point(apex[i]);
-            }
+            // apex is a new point. The face it was reached through (`entry`) is known to be
+            // inside: skip it without a (hard to predict) branch on its mark, and test the
+            // other three, prefetching their apexes first, with one shared fan.
+            let entry = s.entry[head - 1] as usize;
             let q = [
                 self.point_ref(v[0]),
                 self.point_ref(v[1]),
                 self.point_ref(v[2]),
                 self.point_ref(v[3]),
             ];
-            let fan = InsphereFan::new(q, p);
-            // Unrolled (constant face indices let the fan's entries stay at fixed places).
-            self.test_face::<0>(&mut s, &fan, t, v, nb[0], apex[0], p, rank);
-            self.test_face::<1>(&mut s, &fan, t, v, nb[1], apex[1], p, rank);
-            self.test_face::<2>(&mut s, &fan, t, v, nb[2], apex[2], p, rank);
-            self.test_face::<3>(&mut s, &fan, t, v, nb[3], apex[3], p, rank);
+            if entry < 4 {
+                let faces = [(entry + 1) & 3, (entry + 2) & 3, (entry + 3) & 3];
+                let mut apex = [INFINITE; 3];
+                for (a, &i) in apex.iter_mut().zip(&faces) {
+                    let r = nb[i];
+                    *a = self.tet_ref(r >> 2).v[(r & 3) as usize];
+                    self.prefetch_point(*a);
+                }
+                let fan = InsphereFan::new(q, p);
+                for (&a, &i) in apex.iter().zip(&faces) {
+                    self.test_face(&mut s, &fan, t, v, i, nb[i], a, p, rank);
+                }
+            } else {
+                // The start tet: all four faces.
+                let fan = InsphereFan::new(q, p);
+                for (i, &r) in nb.iter().enumerate() {
+                    let a = self.tet_ref(r >> 2).v[(r & 3) as usize];
+                    self.test_face(&mut s, &fan, t, v, i, r, a, p, rank);
+                }
+            }
         }
         // Leave every mark at zero for the next search.
         for &t in &s.cavity {
@@ -215,16 +232,17 @@ impl Delaunay {
     }
 
     /// One neighbour of a dequeued finite cavity tet `t` (vertices `v`): the neighbour across
-    /// face `I` (reference `r`, apex `apex`) is tested if unmarked, and joins the cavity or
-    /// makes face `I` a boundary face.
+    /// face `i` (reference `r`, apex `apex`) is tested if unmarked, and joins the cavity or
+    /// makes face `i` a boundary face.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn test_face<const I: usize>(
+    fn test_face(
         &mut self,
         s: &mut Scratch,
         fan: &InsphereFan,
         t: u32,
         v: [u32; 4],
+        i: usize,
         r: u32,
         apex: u32,
         p: DVec3,
@@ -232,7 +250,7 @@ impl Delaunay {
     ) {
         let n = r >> 2;
         let m = *self.mark_ref(n);
-        let f = FACE[I];
+        let f = FACE[i];
         let (inside, boundary) = if m == 0 {
             let conflict = if apex == INFINITE {
                 self.in_conflict(n, p, rank)
@@ -254,6 +272,8 @@ impl Delaunay {
             let len = s.cavity.len();
             s.cavity.as_mut_ptr().add(len).write(n);
             s.cavity.set_len(len + inside as usize);
+            s.entry.as_mut_ptr().add(len).write((r & 3) as u8);
+            s.entry.set_len(len + inside as usize);
             let len = s.boundary.len();
             let face = BoundaryFace {
                 v: [v[f[0]], v[f[1]], v[f[2]]],
