@@ -155,6 +155,9 @@ fn orient3d_filter(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Option<f64> {
 #[cold]
 #[inline(never)]
 fn orient3d_exact(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
+    if let Some(v) = orient3d_lattice(a, b, c, d) {
+        return v;
+    }
     // robust's orient3d is positive when d lies *below* the plane of counter-clockwise abc,
     // i.e. negative for a right-handed tet: negate to get our convention.
     -robust::orient3d(c3(a), c3(b), c3(c), c3(d))
@@ -216,7 +219,159 @@ fn insphere_filter(a: DVec3, b: DVec3, c: DVec3, d: DVec3, e: DVec3) -> Option<f
 #[cold]
 #[inline(never)]
 fn insphere_exact(a: DVec3, b: DVec3, c: DVec3, d: DVec3, e: DVec3) -> f64 {
+    if let Some(v) = insphere_lattice(a, b, c, d, e) {
+        return v;
+    }
     robust::insphere(c3(b), c3(a), c3(c), c3(d), c3(e))
+}
+
+// ---------------------------------------------------------------------------------------------
+// Exact evaluation on a lattice
+// ---------------------------------------------------------------------------------------------
+//
+// Grids and other lattice inputs make exact zeros (cospherical, coplanar) common, and every
+// zero costs robust's full adaptive evaluation. When every coordinate difference to the last
+// point is computed exactly and all of them are integer multiples `k·2^s` of one power of two
+// with |k| < 2^K, the determinant is evaluated exactly in i128 with Shewchuk's expression on
+// the integers k (scaling all differences by 2^-s scales the determinant by a positive power
+// of two, so the sign is unchanged). Bounds (|k| < 2^K): orient3d |terms| sum below
+// 3·2·2^{3K} = 6·2^{3K} < 2^127 for K = 40; insphere, 2x2 minors < 2^{2K+1}, 3x3 terms
+// < 6·2^{3K}, lifts < 3·2^{2K}, determinant (and every partial sum) < 4·3·6·2^{5K} = 72·2^{5K}
+// < 2^127 for K = 24.
+
+/// `a - b` if it is computed exactly (TwoSum's error term is zero), else `None`.
+#[inline]
+fn exact_diff(a: f64, b: f64) -> Option<f64> {
+    // Knuth's TwoSum of a and -b: t is the rounding error of s (exact without overflow).
+    let s = a - b;
+    let bv = s - a;
+    let av = s - bv;
+    let t = (a - av) + (-b - bv);
+    (t == 0.0 && s.is_finite()).then_some(s)
+}
+
+/// Exponents of the lowest and highest set bits of a finite non-zero double.
+#[inline]
+fn bit_span(x: f64) -> (i32, i32) {
+    let bits = x.to_bits();
+    let exp = ((bits >> 52) & 0x7ff) as i32;
+    let frac = bits & ((1u64 << 52) - 1);
+    let (m, e0) = if exp == 0 {
+        (frac, -1074)
+    } else {
+        (frac | (1u64 << 52), exp - 1075)
+    };
+    (e0 + m.trailing_zeros() as i32, e0 + 63 - m.leading_zeros() as i32)
+}
+
+/// The differences as integers `k` with `d = k·2^s`, if all fit in `|k| < 2^max_bits`.
+fn lattice<const N: usize>(d: [f64; N], max_bits: i32) -> Option<([i128; N], i32)> {
+    let (mut lo, mut hi) = (i32::MAX, i32::MIN);
+    for &x in &d {
+        if x != 0.0 {
+            let (l, h) = bit_span(x);
+            lo = lo.min(l);
+            hi = hi.max(h);
+        }
+    }
+    if lo == i32::MAX {
+        return Some(([0; N], 0)); // all zero
+    }
+    if hi - lo >= max_bits {
+        return None;
+    }
+    let mut k = [0i128; N];
+    for (ki, &x) in k.iter_mut().zip(&d) {
+        if x != 0.0 {
+            let bits = x.to_bits();
+            let exp = ((bits >> 52) & 0x7ff) as i32;
+            let frac = bits & ((1u64 << 52) - 1);
+            let (m, e0) = if exp == 0 {
+                (frac, -1074)
+            } else {
+                (frac | (1u64 << 52), exp - 1075)
+            };
+            let shift = e0 - lo; // >= -trailing_zeros(m): the shifts below are exact
+            let v = if shift >= 0 {
+                (m as i128) << shift
+            } else {
+                (m >> -shift) as i128
+            };
+            *ki = if x < 0.0 { -v } else { v };
+        }
+    }
+    Some((k, lo))
+}
+
+/// `k·2^e` as a double with the sign of k, or `None` if that would overflow or underflow
+/// to zero.
+fn scaled(k: i128, e: i32) -> Option<f64> {
+    if k == 0 {
+        return Some(0.0);
+    }
+    let v = k as f64 * 2f64.powi(e.clamp(-1000, 1000)) * 2f64.powi(e - e.clamp(-1000, 1000));
+    (v.is_finite() && v != 0.0).then_some(v)
+}
+
+/// Exact [`orient3d`] on a lattice (see above), `None` when the differences do not fit.
+#[inline(never)]
+fn orient3d_lattice(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Option<f64> {
+    let diff = [
+        exact_diff(a.x, d.x)?,
+        exact_diff(b.x, d.x)?,
+        exact_diff(c.x, d.x)?,
+        exact_diff(a.y, d.y)?,
+        exact_diff(b.y, d.y)?,
+        exact_diff(c.y, d.y)?,
+        exact_diff(a.z, d.z)?,
+        exact_diff(b.z, d.z)?,
+        exact_diff(c.z, d.z)?,
+    ];
+    let (k, s) = lattice(diff, 40)?;
+    let [adx, bdx, cdx, ady, bdy, cdy, adz, bdz, cdz] = k;
+    let det = adz * (bdx * cdy - cdx * bdy)
+        + bdz * (cdx * ady - adx * cdy)
+        + cdz * (adx * bdy - bdx * ady);
+    // Shewchuk's sign is the opposite of ours.
+    scaled(-det, 3 * s)
+}
+
+/// Exact [`insphere`] on a lattice (see above), `None` when the differences do not fit.
+#[inline(never)]
+fn insphere_lattice(a: DVec3, b: DVec3, c: DVec3, d: DVec3, e: DVec3) -> Option<f64> {
+    // Shewchuk's insphere with (pa, pb, pc, pd, pe) = (b, a, c, d, e), as in `insphere`.
+    let diff = [
+        exact_diff(b.x, e.x)?,
+        exact_diff(a.x, e.x)?,
+        exact_diff(c.x, e.x)?,
+        exact_diff(d.x, e.x)?,
+        exact_diff(b.y, e.y)?,
+        exact_diff(a.y, e.y)?,
+        exact_diff(c.y, e.y)?,
+        exact_diff(d.y, e.y)?,
+        exact_diff(b.z, e.z)?,
+        exact_diff(a.z, e.z)?,
+        exact_diff(c.z, e.z)?,
+        exact_diff(d.z, e.z)?,
+    ];
+    let (k, s) = lattice(diff, 24)?;
+    let [aex, bex, cex, dex, aey, bey, cey, dey, aez, bez, cez, dez] = k;
+    let ab = aex * bey - bex * aey;
+    let bc = bex * cey - cex * bey;
+    let cd = cex * dey - dex * cey;
+    let da = dex * aey - aex * dey;
+    let ac = aex * cey - cex * aey;
+    let bd = bex * dey - dex * bey;
+    let abc = aez * bc - bez * ac + cez * ab;
+    let bcd = bez * cd - cez * bd + dez * bc;
+    let cda = cez * da + dez * ac + aez * cd;
+    let dab = dez * ab + aez * bd + bez * da;
+    let alift = aex * aex + aey * aey + aez * aez;
+    let blift = bex * bex + bey * bey + bez * bez;
+    let clift = cex * cex + cey * cey + cez * cez;
+    let dlift = dex * dex + dey * dey + dez * dez;
+    let det = (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
+    scaled(det, 5 * s)
 }
 
 /// The in-sphere filter of the four tets across the faces of one tet, sharing the work: the
@@ -566,6 +721,51 @@ mod tests {
                 assert_eq!(x.map(f64::to_bits), y.map(f64::to_bits), "{q:?} {apex} {e}");
             }
         }
+    }
+
+    /// The lattice path agrees with robust (signs, and orient3d values up to rounding) on
+    /// lattices at several scales and offsets, exact zeros included, and declines
+    /// non-lattice input.
+    #[test]
+    fn lattice_path_agrees_with_robust() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(99);
+        let (mut decided, mut zeros) = (0, 0);
+        for it in 0..100_000 {
+            let scale = [1.0, 0.5, 2f64.powi(-60), 2f64.powi(70), 3.0][it % 5];
+            let span = [4, 16, 1 << 20][(it / 5) % 3];
+            let offset = [0.0, 1e6, -37.0][(it / 15) % 3] * scale;
+            let mut g = || {
+                DVec3::new(
+                    rng.gen_range(0..span) as f64,
+                    rng.gen_range(0..span) as f64,
+                    rng.gen_range(0..span) as f64,
+                ) * scale
+                    + DVec3::splat(offset)
+            };
+            let (a, b, c, d, e) = (g(), g(), g(), g(), g());
+            let o = robust_orient(a, b, c, d);
+            if let Some(v) = orient3d_lattice(a, b, c, d) {
+                assert_eq!(sign(v), sign(o), "{a} {b} {c} {d}");
+                assert!((v - o).abs() <= 1e-9 * o.abs(), "{v} {o}");
+                decided += 1;
+            }
+            if o != 0.0 {
+                let (p, q) = if o < 0.0 { (b, a) } else { (a, b) };
+                let r = robust_insphere(p, q, c, d, e);
+                if let Some(v) = insphere_lattice(p, q, c, d, e) {
+                    assert_eq!(sign(v), sign(r), "{p} {q} {c} {d} {e}");
+                    decided += 1;
+                    zeros += (v == 0.0) as usize;
+                }
+            }
+        }
+        assert!(decided > 150_000 && zeros > 1000, "{decided} {zeros}");
+        // Not a lattice within the bit budget / inexact differences: declined.
+        let x = DVec3::new(0.1, 0.7, 0.3);
+        assert!(insphere_lattice(DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z, x).is_none());
+        let big = DVec3::new(1e16, 0.0, 0.0);
+        assert!(orient3d_lattice(DVec3::ZERO, DVec3::X, DVec3::Y, big + DVec3::Z * 0.5).is_none());
     }
 
     #[test]
