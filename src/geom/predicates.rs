@@ -222,6 +222,9 @@ fn insphere_exact(a: DVec3, b: DVec3, c: DVec3, d: DVec3, e: DVec3) -> f64 {
     if let Some(v) = insphere_lattice(a, b, c, d, e) {
         return v;
     }
+    if let Some(v) = insphere_fixed(a, b, c, d, e) {
+        return v;
+    }
     robust::insphere(c3(b), c3(a), c3(c), c3(d), c3(e))
 }
 
@@ -309,8 +312,202 @@ fn scaled(k: i128, e: i32) -> Option<f64> {
     if k == 0 {
         return Some(0.0);
     }
-    let v = k as f64 * 2f64.powi(e.clamp(-1000, 1000)) * 2f64.powi(e - e.clamp(-1000, 1000));
-    (v.is_finite() && v != 0.0).then_some(v)
+    scaled_f64(k as f64, e)
+}
+
+/// Exact [`insphere`] in multi-word fixed point, for nearly cospherical inputs that are not
+/// on a coarse lattice (points on a sphere: every test is nearly degenerate). All fifteen
+/// coordinates are written as integers `X·2^s` with one exponent s; if |X| < 2^61 the
+/// differences to e are exact i64 (< 2^62), the 2x2 minors exact i128 (< 2^125), the 3x3
+/// terms 3-word (< 2^189), the lifts i128 (< 2^126) and the determinant 5-word (< 2^317),
+/// all in two's complement. Coordinates spanning more than 61 bits go to robust.
+#[inline(never)]
+fn insphere_fixed(a: DVec3, b: DVec3, c: DVec3, d: DVec3, e: DVec3) -> Option<f64> {
+    // Shewchuk's insphere with (pa, pb, pc, pd, pe) = (b, a, c, d, e), as in `insphere`.
+    let coords = [
+        b.x, a.x, c.x, d.x, e.x, b.y, a.y, c.y, d.y, e.y, b.z, a.z, c.z, d.z, e.z,
+    ];
+    if coords.iter().any(|x| !x.is_finite()) {
+        return None;
+    }
+    let (k, s) = lattice(coords, 61)?;
+    let x = |i: usize| (k[i] - k[4]) as i64;
+    let y = |i: usize| (k[5 + i] - k[9]) as i64;
+    let z = |i: usize| (k[10 + i] - k[14]) as i64;
+    let (aex, bex, cex, dex) = (x(0), x(1), x(2), x(3));
+    let (aey, bey, cey, dey) = (y(0), y(1), y(2), y(3));
+    let (aez, bez, cez, dez) = (z(0), z(1), z(2), z(3));
+    let m = |p: i64, q: i64, r: i64, t: i64| p as i128 * q as i128 - r as i128 * t as i128;
+    let ab = m(aex, bey, bex, aey);
+    let bc = m(bex, cey, cex, bey);
+    let cd = m(cex, dey, dex, cey);
+    let da = m(dex, aey, aex, dey);
+    let ac = m(aex, cey, cex, aey);
+    let bd = m(bex, dey, dex, bey);
+    let abc = W3::mul(aez, bc).sub(W3::mul(bez, ac)).add(W3::mul(cez, ab));
+    let bcd = W3::mul(bez, cd).sub(W3::mul(cez, bd)).add(W3::mul(dez, bc));
+    let cda = W3::mul(cez, da).add(W3::mul(dez, ac)).add(W3::mul(aez, cd));
+    let dab = W3::mul(dez, ab).add(W3::mul(aez, bd)).add(W3::mul(bez, da));
+    let lift = |p: i64, q: i64, r: i64| {
+        p as i128 * p as i128 + q as i128 * q as i128 + r as i128 * r as i128
+    };
+    let alift = lift(aex, aey, aez);
+    let blift = lift(bex, bey, bez);
+    let clift = lift(cex, cey, cez);
+    let dlift = lift(dex, dey, dez);
+    let det = W5::mul(dlift, abc)
+        .sub(W5::mul(clift, dab))
+        .add(W5::mul(blift, cda).sub(W5::mul(alift, bcd)));
+    let (sign, approx) = det.sign_and_approx();
+    if sign == 0 {
+        return Some(0.0);
+    }
+    // The value: the determinant up to rounding, scaled back by 2^(5s) when representable;
+    // only its sign matters to callers, so keep a unit of the right sign otherwise.
+    match scaled_f64(approx, 5 * s) {
+        Some(v) => Some(v),
+        None => Some(sign as f64),
+    }
+}
+
+/// `v·2^e` if finite and non-zero.
+fn scaled_f64(v: f64, e: i32) -> Option<f64> {
+    if !(-2000..=2000).contains(&e) {
+        return None; // |v| < 2^330 here: certain overflow or underflow to zero
+    }
+    let c = e.clamp(-1000, 1000);
+    let r = v * pow2(c) * pow2(e - c);
+    (r.is_finite() && r != 0.0).then_some(r)
+}
+
+/// 2^e for |e| <= 1000, built from its bits.
+#[inline]
+fn pow2(e: i32) -> f64 {
+    debug_assert!((-1000..=1000).contains(&e));
+    f64::from_bits(((e + 1023) as u64) << 52)
+}
+
+/// Magnitude and sign of an i128.
+#[inline(always)]
+fn split_i128(x: i128) -> (bool, u128) {
+    (x < 0, x.unsigned_abs())
+}
+
+/// A 3-word (192-bit) two's-complement integer, little-endian words.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct W3([u64; 3]);
+
+/// A 5-word (320-bit) two's-complement integer, little-endian words.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct W5([u64; 5]);
+
+macro_rules! wide_ops {
+    ($t:ident, $n:expr) => {
+        impl $t {
+            #[inline]
+            fn add(self, o: Self) -> Self {
+                let mut r = [0u64; $n];
+                let mut carry = false;
+                for i in 0..$n {
+                    let (s1, c1) = self.0[i].overflowing_add(o.0[i]);
+                    let (s2, c2) = s1.overflowing_add(carry as u64);
+                    r[i] = s2;
+                    carry = c1 | c2;
+                }
+                $t(r)
+            }
+            #[inline]
+            fn neg(self) -> Self {
+                let mut r = [0u64; $n];
+                let mut carry = true;
+                for i in 0..$n {
+                    let (s, c) = (!self.0[i]).overflowing_add(carry as u64);
+                    r[i] = s;
+                    carry = c;
+                }
+                $t(r)
+            }
+            #[inline]
+            fn sub(self, o: Self) -> Self {
+                self.add(o.neg())
+            }
+            /// Two's complement of the product of a magnitude (`words` little-endian) and
+            /// a sign.
+            #[inline]
+            fn from_mag(neg: bool, words: [u64; $n]) -> Self {
+                let r = $t(words);
+                if neg {
+                    r.neg()
+                } else {
+                    r
+                }
+            }
+        }
+    };
+}
+wide_ops!(W3, 3);
+wide_ops!(W5, 5);
+
+impl W3 {
+    /// Exact `a·b` (|a| < 2^63, |b| < 2^127: the product fits in 190 bits).
+    #[inline]
+    fn mul(a: i64, b: i128) -> W3 {
+        let (na, ma) = (a < 0, a.unsigned_abs() as u128);
+        let (nb, mb) = split_i128(b);
+        let lo = ma * (mb as u64 as u128);
+        let hi = ma * (mb >> 64);
+        // lo + (hi << 64)
+        let w0 = lo as u64;
+        let (mid, c) = ((lo >> 64) as u64).overflowing_add(hi as u64);
+        let w2 = (hi >> 64) as u64 + c as u64;
+        W3::from_mag(na != nb, [w0, mid, w2])
+    }
+}
+
+impl W5 {
+    /// Exact `a·b` (|a| < 2^127, |b| < 2^191 as a two's-complement W3).
+    #[inline]
+    fn mul(a: i128, b: W3) -> W5 {
+        let (na, ma) = split_i128(a);
+        let nb = (b.0[2] as i64) < 0;
+        let mb = if nb { b.neg() } else { b }.0;
+        let a_words = [ma as u64, (ma >> 64) as u64];
+        let mut r = [0u64; 5];
+        for (i, &x) in a_words.iter().enumerate() {
+            let mut carry = 0u128;
+            for (j, &y) in mb.iter().enumerate() {
+                let t = x as u128 * y as u128 + r[i + j] as u128 + carry;
+                r[i + j] = t as u64;
+                carry = t >> 64;
+            }
+            let mut k = i + 3;
+            while carry != 0 && k < 5 {
+                let t = r[k] as u128 + carry;
+                r[k] = t as u64;
+                carry = t >> 64;
+                k += 1;
+            }
+        }
+        W5::from_mag(na != nb, r)
+    }
+
+    /// The sign (-1, 0, 1) and the value rounded to a double (a few ulps).
+    fn sign_and_approx(self) -> (i32, f64) {
+        let neg = (self.0[4] as i64) < 0;
+        let m = if neg { self.neg() } else { self }.0;
+        if m.iter().all(|&w| w == 0) {
+            return (0, 0.0);
+        }
+        let mut v = 0.0;
+        for &w in m.iter().rev() {
+            v = v * 18446744073709551616.0 + w as f64;
+        }
+        if neg {
+            (-1, -v)
+        } else {
+            (1, v)
+        }
+    }
 }
 
 /// Exact [`orient3d`] on a lattice (see above), `None` when the differences do not fit.
@@ -768,6 +965,65 @@ mod tests {
         assert!(orient3d_lattice(DVec3::ZERO, DVec3::X, DVec3::Y, big + DVec3::Z * 0.5).is_none());
     }
 
+    /// The fixed-point path agrees with robust on points on a sphere (nearly cospherical),
+    /// on exactly cospherical dyadic points, and on random points at several scales.
+    #[test]
+    fn fixed_point_insphere_agrees_with_robust() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let mut decided = 0;
+        let mut zeros = 0;
+        for it in 0..60_000 {
+            let scale = [1.0, 2f64.powi(-40), 2f64.powi(50), 3.7][it % 4];
+            let kind = (it / 4) % 3;
+            let mut pt = || -> DVec3 {
+                let v = DVec3::new(rng.gen::<f64>(), rng.gen::<f64>(), rng.gen::<f64>()) * 2.0
+                    - 1.0;
+                match kind {
+                    0 => v.normalize() * scale,
+                    1 => v * scale,
+                    // exactly cospherical: (±3, ±4, 0)/5-type points are not dyadic; use
+                    // points of the sphere x²+y²+z² = 25·4^k with integer coordinates
+                    _ => {
+                        let q = [
+                            [3.0, 4.0, 0.0],
+                            [0.0, 3.0, 4.0],
+                            [4.0, 0.0, 3.0],
+                            [5.0, 0.0, 0.0],
+                            [0.0, -5.0, 0.0],
+                            [0.0, 0.0, -5.0],
+                            [-3.0, 0.0, 4.0],
+                            [-4.0, -3.0, 0.0],
+                        ][rng.gen_range(0..8)];
+                        DVec3::new(q[0], q[1], q[2]) * scale * 0.125 + v * 2f64.powi(-60) * scale * (it % 2) as f64
+                    }
+                }
+            };
+            let (a, mut b, c, d, e) = (pt(), pt(), pt(), pt(), pt());
+            let mut a = a;
+            let o = robust_orient(a, b, c, d);
+            if o == 0.0 {
+                continue;
+            }
+            if o < 0.0 {
+                std::mem::swap(&mut a, &mut b);
+            }
+            let r = robust_insphere(a, b, c, d, e);
+            if let Some(v) = insphere_fixed(a, b, c, d, e) {
+                assert_eq!(sign(v), sign(r), "{a} {b} {c} {d} {e}");
+                decided += 1;
+                zeros += (v == 0.0) as usize;
+            }
+        }
+        assert!(decided > 40_000 && zeros > 500, "{decided} {zeros}");
+        // wide arithmetic corner cases
+        let big = (1i128 << 126) - 1;
+        let w = W3::mul(-(1i64 << 62), big);
+        let back = W5::mul(-big, w);
+        assert!(back.sign_and_approx().0 > 0);
+        assert_eq!(W3::mul(0, big).sign_and_approx_w3(), 0);
+    }
+
     #[test]
     fn filters_on_integer_grids_and_tiny_differences() {
         // Exact zeros (cospherical / coplanar lattice points) and differences near FILTER_MIN.
@@ -793,6 +1049,18 @@ mod tests {
             assert!(insphere(a, b, c, d, DVec3::splat(0.25 * s)) > 0.0, "2^{k}");
             assert!(insphere(a, b, c, d, DVec3::splat(2.0 * s)) < 0.0, "2^{k}");
             assert_eq!(insphere(a, b, c, d, DVec3::splat(s)), 0.0, "2^{k}");
+        }
+    }
+
+    impl W3 {
+        fn sign_and_approx_w3(self) -> i32 {
+            if self.0 == [0; 3] {
+                0
+            } else if (self.0[2] as i64) < 0 {
+                -1
+            } else {
+                1
+            }
         }
     }
 
