@@ -368,7 +368,8 @@ impl Delaunay {
             // Face j (j < 3) holds the new vertex and the boundary edge face[j+1] -> face[j+2];
             // register it, then (second pass) pair it with the reverse edge.
             for j in 0..3 {
-                s.edges.insert(face[(j + 1) % 3], face[(j + 2) % 3], t * 4 + j as u32);
+                s.edges
+                    .insert(face[(j + 1) % 3], face[(j + 2) % 3], t * 4 + j as u32);
             }
             for v in face {
                 if v != INFINITE {

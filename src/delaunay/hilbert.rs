@@ -167,16 +167,38 @@ mod tests {
             let n = 1u32 << bits;
             for c in 0..n * n * n {
                 let cell = [c % n, (c / n) % n, c / (n * n)];
-                assert_eq!(hilbert_index(cell, bits), reference_index(cell, bits), "{cell:?}");
+                assert_eq!(
+                    hilbert_index(cell, bits),
+                    reference_index(cell, bits),
+                    "{cell:?}"
+                );
             }
         }
         let mut s = 12345u64;
         for _ in 0..200_000 {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            let cell = [(s >> 10) as u32 & 1023, (s >> 25) as u32 & 1023, (s >> 40) as u32 & 1023];
-            assert_eq!(hilbert_index(cell, 10), reference_index(cell, 10), "{cell:?}");
-            let cell = [(s >> 2) as u32 & 0x1f_ffff, (s >> 22) as u32 & 0x1f_ffff, (s >> 42) as u32];
-            assert_eq!(hilbert_index(cell, 21), reference_index(cell, 21), "{cell:?}");
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let cell = [
+                (s >> 10) as u32 & 1023,
+                (s >> 25) as u32 & 1023,
+                (s >> 40) as u32 & 1023,
+            ];
+            assert_eq!(
+                hilbert_index(cell, 10),
+                reference_index(cell, 10),
+                "{cell:?}"
+            );
+            let cell = [
+                (s >> 2) as u32 & 0x1f_ffff,
+                (s >> 22) as u32 & 0x1f_ffff,
+                (s >> 42) as u32,
+            ];
+            assert_eq!(
+                hilbert_index(cell, 21),
+                reference_index(cell, 21),
+                "{cell:?}"
+            );
         }
     }
 

@@ -328,15 +328,14 @@ impl Delaunay {
 
     /// The tets (one or two) having face abc, with the local index of their fourth vertex.
     pub fn find_face(&self, a: u32, b: u32, c: u32) -> Option<[(u32, usize); 2]> {
-        let t = self
-            .vertex_star(a)
-            .into_iter()
-            .find(|&t| {
-                let v = self.tets[t as usize].v;
-                v.contains(&b) && v.contains(&c)
-            })?;
+        let t = self.vertex_star(a).into_iter().find(|&t| {
+            let v = self.tets[t as usize].v;
+            v.contains(&b) && v.contains(&c)
+        })?;
         let v = self.tets[t as usize].v;
-        let i = (0..4).find(|&i| v[i] != a && v[i] != b && v[i] != c).unwrap();
+        let i = (0..4)
+            .find(|&i| v[i] != a && v[i] != b && v[i] != c)
+            .unwrap();
         let r = self.tets[t as usize].n[i];
         Some([(t, i), (r >> 2, (r & 3) as usize)])
     }

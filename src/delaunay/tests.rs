@@ -320,7 +320,11 @@ fn tags_are_inherited_through_cavities() {
         let DryRun::Cavity { removed, .. } = dt.dry_run(p, None) else {
             continue;
         };
-        let finite: Vec<u32> = removed.iter().copied().filter(|&t| dt.is_finite(t)).collect();
+        let finite: Vec<u32> = removed
+            .iter()
+            .copied()
+            .filter(|&t| dt.is_finite(t))
+            .collect();
         let tags: Vec<u32> = finite.iter().map(|&t| dt.tag(t)).collect();
         let uniform_tag = tags.iter().all(|&g| g == tags[0]) && removed.len() == finite.len();
         dt.insert(p, None).unwrap();

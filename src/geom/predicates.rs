@@ -264,7 +264,10 @@ fn bit_span(x: f64) -> (i32, i32) {
     } else {
         (frac | (1u64 << 52), exp - 1075)
     };
-    (e0 + m.trailing_zeros() as i32, e0 + 63 - m.leading_zeros() as i32)
+    (
+        e0 + m.trailing_zeros() as i32,
+        e0 + 63 - m.leading_zeros() as i32,
+    )
 }
 
 /// The differences as integers `k` with `d = k·2^s`, if all fit in `|k| < 2^max_bits`.
@@ -825,8 +828,14 @@ mod tests {
         // The evaluation of eps loses at most (1 - u)^5; keep a margin for this test's own
         // rounding (relative 1e-12).
         let shrink = (1.0 - U).powi(5) * (1.0 - 1e-12);
-        assert!(orient.1 / U < 55.001 && ORIENT3D_EPS * shrink > orient.1, "{orient:?}");
-        assert!(ins.1 / U < 1288.001 && INSPHERE_EPS * shrink > ins.1, "{ins:?}");
+        assert!(
+            orient.1 / U < 55.001 && ORIENT3D_EPS * shrink > orient.1,
+            "{orient:?}"
+        );
+        assert!(
+            ins.1 / U < 1288.001 && INSPHERE_EPS * shrink > ins.1,
+            "{ins:?}"
+        );
     }
 
     fn robust_orient(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
@@ -876,7 +885,11 @@ mod tests {
                 }
             }
             let o = orient3d(a, b, c, d);
-            assert_eq!(sign(o), sign(robust_orient(a, b, c, d)), "orient {a} {b} {c} {d}");
+            assert_eq!(
+                sign(o),
+                sign(robust_orient(a, b, c, d)),
+                "orient {a} {b} {c} {d}"
+            );
             if orient3d_filter(a, b, c, d).is_none() {
                 orient_undecided += 1;
             }
@@ -903,13 +916,15 @@ mod tests {
     fn insphere_fan_equals_the_filter_bit_for_bit() {
         use rand::{Rng, SeedableRng};
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
-        let mut rnd = |s: f64| {
-            DVec3::new(rng.gen::<f64>(), rng.gen::<f64>(), rng.gen::<f64>()) * s
-        };
+        let mut rnd = |s: f64| DVec3::new(rng.gen::<f64>(), rng.gen::<f64>(), rng.gen::<f64>()) * s;
         for it in 0..20_000 {
             let s = [1.0, 1e-20, 1e20, 1e-56][it % 4];
             let q = [rnd(s), rnd(s), rnd(s), rnd(s)];
-            let e = if it % 3 == 0 { q[it % 4] + rnd(s) * 1e-9 } else { rnd(s) };
+            let e = if it % 3 == 0 {
+                q[it % 4] + rnd(s) * 1e-9
+            } else {
+                rnd(s)
+            };
             let apex = if it % 5 == 0 { q[(it + 1) % 4] } else { rnd(s) };
             let fan = InsphereFan::new(q, e);
             for (a, b, c) in [(1, 3, 2), (0, 2, 3), (3, 1, 0), (0, 1, 2), (2, 1, 0)] {
@@ -977,8 +992,8 @@ mod tests {
             let scale = [1.0, 2f64.powi(-40), 2f64.powi(50), 3.7][it % 4];
             let kind = (it / 4) % 3;
             let mut pt = || -> DVec3 {
-                let v = DVec3::new(rng.gen::<f64>(), rng.gen::<f64>(), rng.gen::<f64>()) * 2.0
-                    - 1.0;
+                let v =
+                    DVec3::new(rng.gen::<f64>(), rng.gen::<f64>(), rng.gen::<f64>()) * 2.0 - 1.0;
                 match kind {
                     0 => v.normalize() * scale,
                     1 => v * scale,
@@ -995,7 +1010,8 @@ mod tests {
                             [-3.0, 0.0, 4.0],
                             [-4.0, -3.0, 0.0],
                         ][rng.gen_range(0..8)];
-                        DVec3::new(q[0], q[1], q[2]) * scale * 0.125 + v * 2f64.powi(-60) * scale * (it % 2) as f64
+                        DVec3::new(q[0], q[1], q[2]) * scale * 0.125
+                            + v * 2f64.powi(-60) * scale * (it % 2) as f64
                     }
                 }
             };
@@ -1031,9 +1047,19 @@ mod tests {
         let pts: Vec<DVec3> = (0..64).map(|i| g(i % 4, (i / 4) % 4, i / 16)).collect();
         for i in 0..pts.len() {
             for j in (i * 7 % 5)..pts.len() {
-                let (a, b, c, d, e) = (pts[i], pts[j], pts[(i + 5) % 64], pts[(j + 11) % 64], pts[(i * 3 + j) % 64]);
+                let (a, b, c, d, e) = (
+                    pts[i],
+                    pts[j],
+                    pts[(i + 5) % 64],
+                    pts[(j + 11) % 64],
+                    pts[(i * 3 + j) % 64],
+                );
                 assert_eq!(sign(orient3d(a, b, c, d)), sign(robust_orient(a, b, c, d)));
-                let (p, q) = if orient3d(a, b, c, d) < 0.0 { (b, a) } else { (a, b) };
+                let (p, q) = if orient3d(a, b, c, d) < 0.0 {
+                    (b, a)
+                } else {
+                    (a, b)
+                };
                 if orient3d(a, b, c, d) != 0.0 {
                     assert_eq!(
                         sign(insphere(p, q, c, d, e)),
