@@ -7,41 +7,55 @@
 //! conflicting tets around the tet containing p; its boundary is star-shaped from p.
 
 use super::tables::FACE;
-use super::{Delaunay, Inserted, INFINITE, NO_TET};
-use crate::geom::{insphere, insphere_tie, orient3d};
+use super::{has_infinite, Delaunay, Inserted, Tet, DEAD, INFINITE};
+use crate::geom::{insphere, insphere_tie, orient3d, InsphereFan};
 use glam::DVec3;
-use rustc_hash::FxHashMap;
 
 /// Reusable buffers for cavity searches.
 #[derive(Debug, Clone, Default)]
 pub(super) struct Scratch {
     /// Tets in conflict.
     cavity: Vec<u32>,
-    /// Cavity boundary as (cavity tet, local face) pairs.
-    boundary: Vec<(u32, u8)>,
-    stack: Vec<u32>,
-    /// Boundary faces copied out before their tets are reused: vertices, outer neighbour ref,
-    /// tag of the cavity tet that owned the face.
-    faces: Vec<([u32; 3], u32, u32)>,
+    /// For each cavity tet, the local index of the face it was reached through (4: start).
+    entry: Vec<u8>,
+    /// Cavity boundary faces.
+    boundary: Vec<BoundaryFace>,
     /// Tets created by the last insertion.
     pub(super) created: Vec<u32>,
     /// Vertices of the tets the last insertion deleted.
     pub(super) removed: Vec<[u32; 4]>,
+    /// Tags of the boundary faces' owners (when tags are enabled).
+    tags: Vec<u32>,
     /// Directed boundary edge -> face reference of the new tet that owns it.
-    edges: FxHashMap<u64, u32>,
+    edges: EdgeTable,
 }
 
 impl Scratch {
     pub(super) fn memory_bytes(&self) -> usize {
         self.cavity.capacity() * 4
-            + self.boundary.capacity() * 8
-            + self.stack.capacity() * 4
-            + self.faces.capacity() * 20
+            + self.entry.capacity()
+            + self.boundary.capacity() * std::mem::size_of::<BoundaryFace>()
             + self.created.capacity() * 4
             + self.removed.capacity() * 16
-            + self.edges.capacity() * 12
+            + self.tags.capacity() * 4
+            + self.edges.memory_bytes()
     }
 }
+
+/// A face of the cavity boundary, copied out of the cavity tet that owns it (so the slot can
+/// be reused): its vertices as seen from inside the cavity (`FACE` order of the owner), the
+/// reference to the outer neighbour's face, and the owner.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct BoundaryFace {
+    v: [u32; 3],
+    outer: u32,
+    owner: u32,
+}
+
+/// Cavity search marks (zero: not visited).
+const INSIDE: u8 = 1;
+const OUTSIDE: u8 = 2;
+const _: () = assert!(OUTSIDE - 1 == INSIDE);
 
 /// What inserting a point would do, computed without changing the triangulation.
 #[derive(Debug, Clone, PartialEq)]
@@ -82,15 +96,7 @@ impl Delaunay {
         }
         // The would-be vertex ranks above every existing one, as a real insertion would.
         self.find_cavity(p, self.points.len() as u32, start);
-        let faces = self
-            .scratch
-            .boundary
-            .iter()
-            .map(|&(t, i)| {
-                let v = self.tets[t as usize].v;
-                FACE[i as usize].map(|k| v[k])
-            })
-            .collect();
+        let faces = self.scratch.boundary.iter().map(|f| f.v).collect();
         DryRun::Cavity {
             removed: self.scratch.cavity.clone(),
             faces,
@@ -140,102 +146,354 @@ impl Delaunay {
     }
 
     /// Grows the cavity of `p` from `start` (which must conflict) into the scratch buffers.
+    ///
+    /// Breadth-first, with the cavity list as the queue: when a tet joins the cavity its
+    /// neighbours' records and marks are prefetched, and they are usually in cache by the time
+    /// it is dequeued and they are tested.
     fn find_cavity(&mut self, p: DVec3, rank: u32, start: u32) {
-        const INSIDE: u8 = 1;
-        const OUTSIDE: u8 = 2;
         let mut s = std::mem::take(&mut self.scratch);
         s.cavity.clear();
+        s.entry.clear();
         s.boundary.clear();
-        s.stack.clear();
         self.mark[start as usize] = INSIDE;
         s.cavity.push(start);
-        s.stack.push(start);
-        while let Some(t) = s.stack.pop() {
-            for i in 0..4 {
-                let n = self.tets[t as usize].n[i] >> 2;
-                let m = self.mark[n as usize];
-                if m == INSIDE {
-                    continue;
-                }
-                if m != OUTSIDE {
-                    if self.in_conflict(n, p, rank) {
-                        self.mark[n as usize] = INSIDE;
-                        s.cavity.push(n);
-                        s.stack.push(n);
+        s.entry.push(4);
+        let mut head = 0;
+        while head < s.cavity.len() {
+            let t = s.cavity[head];
+            head += 1;
+            let Tet { v, n: nb } = *self.tet_ref(t);
+            s.cavity.reserve(4);
+            s.entry.reserve(4);
+            s.boundary.reserve(4);
+            if has_infinite(v) {
+                // A hull tet: the general test for each neighbour.
+                for (i, &r) in nb.iter().enumerate() {
+                    let n = r >> 2;
+                    let m = *self.mark_ref(n);
+                    if m == INSIDE {
                         continue;
                     }
-                    self.mark[n as usize] = OUTSIDE;
+                    if m != OUTSIDE {
+                        if self.in_conflict(n, p, rank) {
+                            *self.mark_mut(n) = INSIDE;
+                            s.cavity.push(n);
+                            s.entry.push((r & 3) as u8);
+                            self.prefetch_neighbors(n);
+                            continue;
+                        }
+                        *self.mark_mut(n) = OUTSIDE;
+                    }
+                    s.boundary.push(BoundaryFace {
+                        v: FACE[i].map(|k| v[k]),
+                        outer: r,
+                        owner: t,
+                    });
                 }
-                s.boundary.push((t, i as u8));
+                continue;
+            }
+            // A finite tet: the neighbour across face i is (face i reversed, apex); only its
+            // apex is a new point. The face it was reached through (`entry`) is known to be
+            // inside: skip it without a (hard to predict) branch on its mark, and test the
+            // other three, prefetching their apexes first, with one shared fan.
+            let entry = s.entry[head - 1] as usize;
+            let q = [
+                self.point_ref(v[0]),
+                self.point_ref(v[1]),
+                self.point_ref(v[2]),
+                self.point_ref(v[3]),
+            ];
+            if entry < 4 {
+                let faces = [(entry + 1) & 3, (entry + 2) & 3, (entry + 3) & 3];
+                let mut apex = [INFINITE; 3];
+                for (a, &i) in apex.iter_mut().zip(&faces) {
+                    let r = nb[i];
+                    *a = self.tet_ref(r >> 2).v[(r & 3) as usize];
+                    self.prefetch_point(*a);
+                }
+                let fan = InsphereFan::new(q, p);
+                for (&a, &i) in apex.iter().zip(&faces) {
+                    self.test_face(&mut s, &fan, t, v, i, nb[i], a, p, rank);
+                }
+            } else {
+                // The start tet: all four faces.
+                let fan = InsphereFan::new(q, p);
+                for (i, &r) in nb.iter().enumerate() {
+                    let a = self.tet_ref(r >> 2).v[(r & 3) as usize];
+                    self.test_face(&mut s, &fan, t, v, i, r, a, p, rank);
+                }
             }
         }
         // Leave every mark at zero for the next search.
         for &t in &s.cavity {
-            self.mark[t as usize] = 0;
+            *self.mark_mut(t) = 0;
         }
-        for &(t, i) in &s.boundary {
-            self.mark[(self.tets[t as usize].n[i as usize] >> 2) as usize] = 0;
+        for f in &s.boundary {
+            *self.mark_mut(f.outer >> 2) = 0;
         }
         self.scratch = s;
     }
 
+    /// One neighbour of a dequeued finite cavity tet `t` (vertices `v`): the neighbour across
+    /// face `i` (reference `r`, apex `apex`) is tested if unmarked, and joins the cavity or
+    /// makes face `i` a boundary face.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn test_face(
+        &mut self,
+        s: &mut Scratch,
+        fan: &InsphereFan,
+        t: u32,
+        v: [u32; 4],
+        i: usize,
+        r: u32,
+        apex: u32,
+        p: DVec3,
+        rank: u32,
+    ) {
+        let n = r >> 2;
+        let m = *self.mark_ref(n);
+        let f = FACE[i];
+        let (inside, boundary) = if m == 0 {
+            let conflict = if apex == INFINITE {
+                self.in_conflict(n, p, rank)
+            } else {
+                match fan.across(f[0], f[1], f[2], self.point_ref(apex), p) {
+                    Some(det) => det > 0.0,
+                    None => self.finite_in_conflict(n, p, rank),
+                }
+            };
+            *self.mark_mut(n) = OUTSIDE - conflict as u8;
+            self.prefetch_neighbors(n);
+            (conflict, !conflict)
+        } else {
+            (false, m == OUTSIDE)
+        };
+        // Branch-free pushes: write the slot, advance the length by the condition.
+        // SAFETY: the caller reserved capacity for 4 more of each.
+        unsafe {
+            let len = s.cavity.len();
+            s.cavity.as_mut_ptr().add(len).write(n);
+            s.cavity.set_len(len + inside as usize);
+            s.entry.as_mut_ptr().add(len).write((r & 3) as u8);
+            s.entry.set_len(len + inside as usize);
+            let len = s.boundary.len();
+            let face = BoundaryFace {
+                v: [v[f[0]], v[f[1]], v[f[2]]],
+                outer: r,
+                owner: t,
+            };
+            s.boundary.as_mut_ptr().add(len).write(face);
+            s.boundary.set_len(len + boundary as usize);
+        }
+    }
+
+    /// Hints the coordinates of vertex `v` (any id, `INFINITE` included) into the cache.
+    #[inline(always)]
+    fn prefetch_point(&self, v: u32) {
+        #[cfg(target_arch = "x86_64")]
+        unsafe {
+            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+            // wrapping: the address is only a hint, never dereferenced
+            let ptr = self.points.as_ptr().wrapping_add(v as usize) as *const i8;
+            _mm_prefetch(ptr, _MM_HINT_T0);
+            _mm_prefetch(ptr.wrapping_add(16), _MM_HINT_T0);
+        }
+    }
+
+    /// Hints the records and marks of `t`'s neighbours into the cache.
+    #[inline(always)]
+    fn prefetch_neighbors(&self, t: u32) {
+        #[cfg(target_arch = "x86_64")]
+        unsafe {
+            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+            for r in self.tet_ref(t).n {
+                let n = (r >> 2) as usize;
+                _mm_prefetch(self.tets.as_ptr().add(n) as *const i8, _MM_HINT_T0);
+                _mm_prefetch(self.mark.as_ptr().add(n) as *const i8, _MM_HINT_T0);
+            }
+        }
+    }
+
     /// Replaces the cavity in the scratch buffers by the star of vertex `id`.
+    ///
+    /// The new tets reuse the cavity's slots first (then the free list, then fresh slots);
+    /// their mutual links are found by pairing each directed boundary edge with its reverse
+    /// in a small open-addressing table.
     fn fill_cavity(&mut self, id: u32) {
         let mut s = std::mem::take(&mut self.scratch);
-        s.faces.clear();
-        for &(t, i) in &s.boundary {
-            let v = self.tets[t as usize].v;
-            let face = FACE[i as usize].map(|k| v[k]);
-            let tag = self.tags.get(t as usize).copied().unwrap_or(0);
-            s.faces
-                .push((face, self.tets[t as usize].n[i as usize], tag));
-        }
+        // Remember the deleted tets (refinement re-checks the boundary elements they held).
         s.removed.clear();
         for &t in &s.cavity {
-            s.removed.push(self.tets[t as usize].v);
-            self.free_tet(t);
+            s.removed.push(self.tet_ref(t).v);
         }
-        s.edges.clear();
+        let removed_ghosts = s
+            .cavity
+            .iter()
+            .filter(|&&t| has_infinite(self.tet_ref(t).v))
+            .count();
+        // Slots: the cavity's first, then the free list, then new ones.
+        let (nf, nc) = (s.boundary.len(), s.cavity.len());
         s.created.clear();
-        for &(face, outer, tag) in &s.faces {
-            let t = self.alloc_tet([face[0], face[1], face[2], id]);
-            s.created.push(t);
-            if self.tags_enabled {
-                self.tags[t as usize] = tag;
-            }
-            let me = t * 4 + 3;
-            self.set_neighbor(me, outer);
-            self.set_neighbor(outer, me);
-            // Face j (j < 3) holds the new vertex and the boundary edge face[j+1] -> face[j+2];
-            // the neighbouring boundary face runs along that edge the other way.
-            for j in 0..3 {
-                let (a, b) = (face[(j + 1) % 3], face[(j + 2) % 3]);
-                let mine = t * 4 + j as u32;
-                match s.edges.remove(&edge_key(b, a)) {
-                    Some(other) => {
-                        self.set_neighbor(mine, other);
-                        self.set_neighbor(other, mine);
+        s.created.extend_from_slice(&s.cavity[..nf.min(nc)]);
+        for _ in nc..nf {
+            let t = match self.free.pop() {
+                Some(t) => t,
+                None => {
+                    self.grow_tets();
+                    self.tets.push(Tet::default());
+                    self.mark.push(0);
+                    if self.tags_enabled {
+                        self.tags.push(0);
                     }
-                    None => {
-                        s.edges.insert(edge_key(a, b), mine);
-                    }
+                    (self.tets.len() - 1) as u32
                 }
+            };
+            s.created.push(t);
+        }
+        // Tags of the owners, read before their slots are overwritten.
+        if self.tags_enabled {
+            s.tags.clear();
+            s.tags
+                .extend(s.boundary.iter().map(|f| self.tags[f.owner as usize]));
+        }
+        for &t in s.cavity.iter().skip(nf) {
+            self.tet_mut(t).v = [DEAD; 4];
+            self.free.push(t);
+        }
+        s.edges.begin(nf);
+        let mut new_ghosts = 0;
+        for (k, (f, &t)) in s.boundary.iter().zip(&s.created).enumerate() {
+            let face = f.v;
+            *self.tet_mut(t) = Tet {
+                v: [face[0], face[1], face[2], id],
+                n: [0, 0, 0, f.outer],
+            };
+            if self.tags_enabled {
+                self.tags[t as usize] = s.tags[k];
+            }
+            self.tet_mut(f.outer >> 2).n[(f.outer & 3) as usize] = t * 4 + 3;
+            // Face j (j < 3) holds the new vertex and the boundary edge face[j+1] -> face[j+2];
+            // register it, then (second pass) pair it with the reverse edge.
+            for j in 0..3 {
+                s.edges
+                    .insert(face[(j + 1) % 3], face[(j + 2) % 3], t * 4 + j as u32);
             }
             for v in face {
                 if v != INFINITE {
-                    self.vertex_tet[v as usize] = t;
+                    debug_assert!((v as usize) < self.vertex_tet.len());
+                    // SAFETY: finite vertex ids of alive tets index the vertex arrays.
+                    unsafe { *self.vertex_tet.get_unchecked_mut(v as usize) = t };
+                } else {
+                    new_ghosts += 1;
                 }
             }
-            self.vertex_tet[id as usize] = t;
-            self.last = t;
         }
-        debug_assert!(
-            s.edges.is_empty(),
-            "cavity boundary is not a closed surface"
-        );
-        debug_assert!(self.vertex_tet[id as usize] != NO_TET);
+        // The neighbouring boundary face runs along each edge the other way. Each side writes
+        // its own link.
+        for (f, &t) in s.boundary.iter().zip(&s.created) {
+            let face = f.v;
+            for j in 0..3 {
+                let other = s.edges.get(face[(j + 2) % 3], face[(j + 1) % 3]);
+                self.tet_mut(t).n[j] = other;
+            }
+        }
+        let last = *s.created.last().expect("a cavity has boundary faces");
+        self.vertex_tet[id as usize] = last;
+        self.last = last;
+        self.n_alive = self.n_alive + nf - nc;
+        self.n_ghost = self.n_ghost + new_ghosts - removed_ghosts;
         self.scratch = s;
     }
+}
+
+/// Directed boundary edges of a cavity and the new faces owning them: open addressing with
+/// linear probing, invalidated wholesale per cavity by a generation stamp. All edges are
+/// inserted first, then looked up, so the probes' branches are predictable.
+#[derive(Debug, Clone, Default)]
+pub(super) struct EdgeTable {
+    slots: Vec<EdgeSlot>,
+    generation: u32,
+    shift: u32,
+}
+
+/// One slot: a directed edge, its owner, and the generation that wrote it (one 16-byte
+/// record, so a probe touches one cache line).
+#[derive(Debug, Clone, Copy, Default)]
+#[repr(C, align(16))]
+struct EdgeSlot {
+    key: u64,
+    val: u32,
+    stamp: u32,
+}
+
+impl EdgeTable {
+    /// Starts a new cavity with `faces` boundary faces.
+    #[inline]
+    fn begin(&mut self, faces: usize) {
+        // 3 directed edges per face: keep the load factor <= 3/16.
+        let want = (faces * 16).next_power_of_two().max(512);
+        if want > self.slots.len() {
+            self.slots = vec![EdgeSlot::default(); want];
+            self.generation = 0;
+            self.shift = 64 - want.trailing_zeros();
+        }
+        self.generation = self.generation.wrapping_add(1);
+        if self.generation == 0 {
+            self.slots.fill(EdgeSlot::default());
+            self.generation = 1;
+        }
+    }
+
+    /// Registers directed edge `a -> b` owned by face reference `val`.
+    #[inline]
+    fn insert(&mut self, a: u32, b: u32, val: u32) {
+        let mask = self.slots.len() - 1;
+        let mut slot = (edge_hash(a, b) >> self.shift) as usize;
+        // SAFETY: slots are masked to the table length (a power of two).
+        unsafe {
+            while self.slots.get_unchecked(slot).stamp == self.generation {
+                slot = (slot + 1) & mask;
+            }
+            *self.slots.get_unchecked_mut(slot) = EdgeSlot {
+                key: edge_key(a, b),
+                val,
+                stamp: self.generation,
+            };
+        }
+    }
+
+    /// The owner of directed edge `a -> b`, which must have been registered (the cavity
+    /// boundary is a closed surface: every edge appears once in each direction).
+    #[inline]
+    fn get(&self, a: u32, b: u32) -> u32 {
+        let mask = self.slots.len() - 1;
+        let want = edge_key(a, b);
+        let mut slot = (edge_hash(a, b) >> self.shift) as usize;
+        // SAFETY: slots are masked to the table length (a power of two).
+        unsafe {
+            loop {
+                let e = self.slots.get_unchecked(slot);
+                assert!(
+                    e.stamp == self.generation,
+                    "cavity boundary is not a closed surface"
+                );
+                if e.key == want {
+                    return e.val;
+                }
+                slot = (slot + 1) & mask;
+            }
+        }
+    }
+
+    fn memory_bytes(&self) -> usize {
+        self.slots.capacity() * std::mem::size_of::<EdgeSlot>()
+    }
+}
+
+#[inline]
+fn edge_hash(a: u32, b: u32) -> u64 {
+    (edge_key(a, b) ^ (a as u64).rotate_left(17)).wrapping_mul(0x9E37_79B9_7F4A_7C15)
 }
 
 #[inline]

@@ -15,69 +15,84 @@ const ROUND_RATIO: usize = 8;
 const MIN_ROUND: usize = 1024;
 
 /// Hilbert index of a cell with `bits`-bit coordinates (Skilling, "Programming the Hilbert
-/// curve", AIP Conf. Proc. 707, 2004: axes to transpose, then bit interleave).
+/// curve", AIP Conf. Proc. 707, 2004: axes to transpose, then bit interleave). Branch-free
+/// (the data-dependent branches of the textbook loop mispredict half the time).
+#[inline]
 pub fn hilbert_index(cell: [u32; 3], bits: u32) -> u64 {
-    let mut x = cell;
-    let m = 1u32 << (bits - 1);
-    let mut q = m;
-    while q > 1 {
-        let p = q - 1;
-        for i in 0..3 {
-            if x[i] & q != 0 {
-                x[0] ^= p;
-            } else {
-                let t = (x[0] ^ x[i]) & p;
-                x[0] ^= t;
-                x[i] ^= t;
-            }
-        }
-        q >>= 1;
+    let [mut x0, mut x1, mut x2] = cell;
+    // Inverse undo: for each level q (high to low), per axis i: if bit q of x[i] is set,
+    // invert the low bits of x[0]; else exchange the low bits of x[0] and x[i].
+    let mut b = bits - 1;
+    while b > 0 {
+        let p = (1u32 << b) - 1;
+        // axis 0: set -> x0 ^= p; clear -> exchange with itself (no-op)
+        x0 ^= p & ((x0 >> b) & 1).wrapping_neg();
+        let m1 = ((x1 >> b) & 1).wrapping_neg();
+        let t1 = (x0 ^ x1) & p & !m1;
+        x0 ^= (p & m1) ^ t1;
+        x1 ^= t1;
+        let m2 = ((x2 >> b) & 1).wrapping_neg();
+        let t2 = (x0 ^ x2) & p & !m2;
+        x0 ^= (p & m2) ^ t2;
+        x2 ^= t2;
+        b -= 1;
     }
-    for i in 1..3 {
-        x[i] ^= x[i - 1];
-    }
+    // Gray encode.
+    x1 ^= x0;
+    x2 ^= x1;
     let mut t = 0;
-    let mut q = m;
-    while q > 1 {
-        if x[2] & q != 0 {
-            t ^= q - 1;
-        }
-        q >>= 1;
+    let mut b = bits - 1;
+    while b > 0 {
+        t ^= ((1u32 << b) - 1) & ((x2 >> b) & 1).wrapping_neg();
+        b -= 1;
     }
-    for xi in &mut x {
-        *xi ^= t;
-    }
-    let mut h = 0u64;
-    for b in (0..bits).rev() {
-        for xi in &x {
-            h = (h << 1) | ((xi >> b) & 1) as u64;
-        }
-    }
-    h
+    x0 ^= t;
+    x1 ^= t;
+    x2 ^= t;
+    // Interleave: bit b of x0, x1, x2 -> bits 3b+2, 3b+1, 3b of the index.
+    (spread3(x0) << 2) | (spread3(x1) << 1) | spread3(x2)
+}
+
+/// Spreads the low 21 bits of `x` to every third bit.
+#[inline(always)]
+fn spread3(x: u32) -> u64 {
+    let mut v = (x & 0x1f_ffff) as u64;
+    v = (v | (v << 32)) & 0x001f_0000_0000_ffff;
+    v = (v | (v << 16)) & 0x001f_0000_ff00_00ff;
+    v = (v | (v << 8)) & 0x100f_00f0_0f00_f00f;
+    v = (v | (v << 4)) & 0x10c3_0c30_c30c_30c3;
+    v = (v | (v << 2)) & 0x1249_2492_4924_9249;
+    v
 }
 
 /// Sorts `ids` (indices into `points`) along the Hilbert curve of `points`' bounding box.
 pub fn hilbert_sort(points: &[DVec3], ids: &mut [u32]) {
+    let mut buf = vec![];
+    hilbert_sort_with(points, ids, &mut buf);
+}
+
+/// [`hilbert_sort`] with a reusable buffer. Equal cells keep id order.
+fn hilbert_sort_with(points: &[DVec3], ids: &mut [u32], keyed: &mut Vec<u64>) {
     if ids.len() < 2 {
         return;
     }
+    // One (random-access) gather; then bounding box and keys stream over the copy.
+    let local: Vec<DVec3> = ids.iter().map(|&i| points[i as usize]).collect();
     let (mut lo, mut hi) = (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN));
-    for &i in ids.iter() {
-        lo = lo.min(points[i as usize]);
-        hi = hi.max(points[i as usize]);
+    for &p in &local {
+        lo = lo.min(p);
+        hi = hi.max(p);
     }
     let extent = (hi - lo).max_element().max(f64::MIN_POSITIVE);
     let scale = ((1u32 << BITS) - 1) as f64 / extent;
-    let mut keyed: Vec<(u64, u32)> = ids
-        .iter()
-        .map(|&i| {
-            let c = (points[i as usize] - lo) * scale;
-            (hilbert_index([c.x as u32, c.y as u32, c.z as u32], BITS), i)
-        })
-        .collect();
+    keyed.clear();
+    keyed.extend(local.iter().zip(ids.iter()).map(|(&p, &i)| {
+        let c = (p - lo) * scale;
+        (hilbert_index([c.x as u32, c.y as u32, c.z as u32], BITS) << 32) | i as u64
+    }));
     keyed.sort_unstable();
-    for (slot, (_, i)) in ids.iter_mut().zip(keyed) {
-        *slot = i;
+    for (slot, &k) in ids.iter_mut().zip(keyed.iter()) {
+        *slot = k as u32;
     }
 }
 
@@ -87,6 +102,7 @@ pub fn brio_order(points: &[DVec3], seed: u64) -> Vec<u32> {
     let mut ids: Vec<u32> = (0..points.len() as u32).collect();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
     ids.shuffle(&mut rng);
+    let mut keyed = Vec::with_capacity(points.len());
     let mut end = ids.len();
     while end > 0 {
         let start = if end > MIN_ROUND {
@@ -94,7 +110,7 @@ pub fn brio_order(points: &[DVec3], seed: u64) -> Vec<u32> {
         } else {
             0
         };
-        hilbert_sort(points, &mut ids[start..end]);
+        hilbert_sort_with(points, &mut ids[start..end], &mut keyed);
         end = start;
     }
     ids
@@ -103,6 +119,88 @@ pub fn brio_order(points: &[DVec3], seed: u64) -> Vec<u32> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The textbook (branching) transcription of Skilling's algorithm.
+    fn reference_index(cell: [u32; 3], bits: u32) -> u64 {
+        let mut x = cell;
+        let m = 1u32 << (bits - 1);
+        let mut q = m;
+        while q > 1 {
+            let p = q - 1;
+            for i in 0..3 {
+                if x[i] & q != 0 {
+                    x[0] ^= p;
+                } else {
+                    let t = (x[0] ^ x[i]) & p;
+                    x[0] ^= t;
+                    x[i] ^= t;
+                }
+            }
+            q >>= 1;
+        }
+        for i in 1..3 {
+            x[i] ^= x[i - 1];
+        }
+        let mut t = 0;
+        let mut q = m;
+        while q > 1 {
+            if x[2] & q != 0 {
+                t ^= q - 1;
+            }
+            q >>= 1;
+        }
+        for xi in &mut x {
+            *xi ^= t;
+        }
+        let mut h = 0u64;
+        for b in (0..bits).rev() {
+            for xi in &x {
+                h = (h << 1) | ((xi >> b) & 1) as u64;
+            }
+        }
+        h
+    }
+
+    #[test]
+    fn branch_free_index_matches_reference() {
+        for bits in 1..=5 {
+            let n = 1u32 << bits;
+            for c in 0..n * n * n {
+                let cell = [c % n, (c / n) % n, c / (n * n)];
+                assert_eq!(
+                    hilbert_index(cell, bits),
+                    reference_index(cell, bits),
+                    "{cell:?}"
+                );
+            }
+        }
+        let mut s = 12345u64;
+        for _ in 0..200_000 {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let cell = [
+                (s >> 10) as u32 & 1023,
+                (s >> 25) as u32 & 1023,
+                (s >> 40) as u32 & 1023,
+            ];
+            assert_eq!(
+                hilbert_index(cell, 10),
+                reference_index(cell, 10),
+                "{cell:?}"
+            );
+            let cell = [
+                (s >> 2) as u32 & 0x1f_ffff,
+                (s >> 22) as u32 & 0x1f_ffff,
+                (s >> 42) as u32,
+            ];
+            assert_eq!(
+                hilbert_index(cell, 21),
+                reference_index(cell, 21),
+                "{cell:?}"
+            );
+        }
+    }
 
     #[test]
     fn hilbert_curve_visits_neighbouring_cells() {

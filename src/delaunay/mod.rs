@@ -138,8 +138,10 @@ impl Delaunay {
             rng: 0x9e37_79b9,
             ..Default::default()
         };
-        // Euler: ~6.7 tets per point for uniform points; reserving avoids a doubling peak.
-        let expected = points.len() * 27 / 4 + 64;
+        // Uniform points give ~6.77 tets per point (24π²/35 for a Poisson process, a little
+        // less with the boundary); reserving avoids a doubling peak, and growth beyond is by
+        // 1/8 steps (`grow_tets`).
+        let expected = points.len() * 68 / 10 + 64;
         dt.tets.reserve(expected);
         dt.mark.reserve(expected);
         let sequence: Vec<u32> = (0..points.len() as u32).collect();
@@ -152,7 +154,7 @@ impl Delaunay {
             if first.contains(&id) {
                 continue;
             }
-            let hint = dt.last;
+            let hint = dt.hint_towards(dt.points[id as usize]);
             match dt.insert_vertex(id, hint) {
                 Inserted::New(_) => stats.inserted += 1,
                 Inserted::Duplicate(_) => stats.duplicates += 1,
@@ -177,7 +179,10 @@ impl Delaunay {
         self.points.push(p);
         self.vertex_tet.push(NO_TET);
         self.rank.push(index as u32);
-        let hint = hint.filter(|&t| self.is_alive(t)).unwrap_or(self.last);
+        let hint = match hint.filter(|&t| self.is_alive(t)) {
+            Some(t) => t,
+            None => self.hint_towards(p),
+        };
         let r = self.insert_vertex(index as u32, hint);
         if let Inserted::Duplicate(_) = r {
             self.points.pop();
@@ -229,7 +234,7 @@ impl Delaunay {
     }
     /// Whether alive tet `t` is finite (carries no infinite vertex).
     pub fn is_finite(&self, t: u32) -> bool {
-        !self.tets[t as usize].v.contains(&INFINITE)
+        !has_infinite(self.tets[t as usize].v)
     }
     /// Vertex ids of tet `t` (positively oriented if finite).
     pub fn tet(&self, t: u32) -> [u32; 4] {
@@ -425,9 +430,60 @@ impl Delaunay {
         }
     }
 
+    // Unchecked accessors for the hot paths. Invariants: neighbour references of alive tets
+    // name existing slots (`tets` never shrinks), and finite vertex ids of alive tets index
+    // `points` (checked in debug builds).
+
+    #[inline(always)]
+    fn tet_ref(&self, t: u32) -> &Tet {
+        debug_assert!((t as usize) < self.tets.len());
+        // SAFETY: see the invariants above.
+        unsafe { self.tets.get_unchecked(t as usize) }
+    }
+    #[inline(always)]
+    fn tet_mut(&mut self, t: u32) -> &mut Tet {
+        debug_assert!((t as usize) < self.tets.len());
+        // SAFETY: see the invariants above.
+        unsafe { self.tets.get_unchecked_mut(t as usize) }
+    }
+    #[inline(always)]
+    fn mark_ref(&self, t: u32) -> &u8 {
+        debug_assert!((t as usize) < self.mark.len());
+        // SAFETY: `mark` has one entry per tet slot.
+        unsafe { self.mark.get_unchecked(t as usize) }
+    }
+    #[inline(always)]
+    fn mark_mut(&mut self, t: u32) -> &mut u8 {
+        debug_assert!((t as usize) < self.mark.len());
+        // SAFETY: `mark` has one entry per tet slot.
+        unsafe { self.mark.get_unchecked_mut(t as usize) }
+    }
+    /// Coordinates of a finite vertex of an alive tet.
+    #[inline(always)]
+    fn point_ref(&self, v: u32) -> DVec3 {
+        debug_assert!((v as usize) < self.points.len());
+        // SAFETY: see the invariants above.
+        unsafe { *self.points.get_unchecked(v as usize) }
+    }
+
     #[inline]
     fn set_neighbor(&mut self, from: u32, to: u32) {
         self.tets[(from >> 2) as usize].n[(from & 3) as usize] = to;
+    }
+
+    /// Makes room for one more tet slot, growing the arrays by 1/8 (not Vec's doubling, which
+    /// would nearly double the peak memory when a big triangulation barely outgrows its
+    /// reservation).
+    #[inline]
+    fn grow_tets(&mut self) {
+        if self.tets.len() == self.tets.capacity() {
+            let extra = self.tets.len() / 8 + 1024;
+            self.tets.reserve_exact(extra);
+            self.mark.reserve_exact(extra);
+            if self.tags_enabled {
+                self.tags.reserve_exact(extra);
+            }
+        }
     }
 
     fn alloc_tet(&mut self, v: [u32; 4]) -> u32 {
@@ -439,6 +495,7 @@ impl Delaunay {
             self.tets[t as usize].v = v;
             t
         } else {
+            self.grow_tets();
             self.tets.push(Tet {
                 v,
                 n: [u32::MAX; 4],
@@ -451,15 +508,6 @@ impl Delaunay {
         }
     }
 
-    fn free_tet(&mut self, t: u32) {
-        self.n_alive -= 1;
-        if self.tets[t as usize].v.contains(&INFINITE) {
-            self.n_ghost -= 1;
-        }
-        self.tets[t as usize].v = [DEAD; 4];
-        self.free.push(t);
-    }
-
     /// Cheap xorshift for the walk's random first face.
     #[inline]
     fn next_random(&mut self) -> u32 {
@@ -470,6 +518,13 @@ impl Delaunay {
         self.rng = x;
         x
     }
+}
+
+/// Whether a tet's vertex list holds the infinite vertex (branch-free: `INFINITE` is the
+/// largest id, and dead slots never reach here).
+#[inline(always)]
+fn has_infinite(v: [u32; 4]) -> bool {
+    v[0].max(v[1]).max(v[2].max(v[3])) == INFINITE
 }
 
 /// Exact collinearity: the three points are collinear iff all three coordinate-plane

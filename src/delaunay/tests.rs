@@ -296,3 +296,45 @@ fn validate_catches_corruption() {
     moved.points[v as usize] = moved.points[v as usize].lerp(centre, 0.3);
     assert!(moved.validate().is_err());
 }
+
+#[test]
+fn tags_are_inherited_through_cavities() {
+    let pts = uniform(2000, 11);
+    let (mut dt, _) = Delaunay::from_points(&pts).unwrap();
+    dt.enable_tags();
+    let region = |dt: &Delaunay, t: u32| {
+        let c = dt.tet_points(t).iter().sum::<DVec3>() / 4.0;
+        if c.x < 0.5 {
+            1
+        } else {
+            2
+        }
+    };
+    let ids: Vec<u32> = dt.finite_tet_ids().collect();
+    for t in ids {
+        let r = region(&dt, t);
+        dt.set_tag(t, r);
+    }
+    let mut checked = 0;
+    for p in uniform(300, 12) {
+        let DryRun::Cavity { removed, .. } = dt.dry_run(p, None) else {
+            continue;
+        };
+        let finite: Vec<u32> = removed
+            .iter()
+            .copied()
+            .filter(|&t| dt.is_finite(t))
+            .collect();
+        let tags: Vec<u32> = finite.iter().map(|&t| dt.tag(t)).collect();
+        let uniform_tag = tags.iter().all(|&g| g == tags[0]) && removed.len() == finite.len();
+        dt.insert(p, None).unwrap();
+        if uniform_tag {
+            for &t in dt.last_created() {
+                assert_eq!(dt.tag(t), tags[0]);
+            }
+            checked += 1;
+        }
+    }
+    assert!(checked > 100, "{checked}");
+    dt.validate().unwrap();
+}
