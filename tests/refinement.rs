@@ -184,12 +184,16 @@ fn acute_models_terminate_and_meet_bounds_away_from_small_angles() {
     let params = Params::default();
     for rel in ["off/star.off", "off/oblong.off"] {
         let input = read_model(rel);
-        let (m, report) = mesh(&input, &params, None, None).unwrap_or_else(|e| panic!("{rel}: {e}"));
+        let (m, report) =
+            mesh(&input, &params, None, None).unwrap_or_else(|e| panic!("{rel}: {e}"));
         assert!(report.complete, "{rel}: {:?}", report.stop_reason);
         check_orientation(&m);
         check_boundary_faces_are_tet_faces(&m);
         let want: f64 = facet_area_by_marker(&input).values().sum();
         let got: f64 = boundary_area_by_marker(&m).values().sum();
-        assert!(rel_close(got, want, 1e-9), "{rel}: boundary area {got}, facets {want}");
+        assert!(
+            rel_close(got, want, 1e-9),
+            "{rel}: boundary area {got}, facets {want}"
+        );
     }
 }

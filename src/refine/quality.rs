@@ -321,10 +321,14 @@ impl<'a> Refiner<'a> {
         let mut facets = vec![];
         // The cavity and the ring of tets around it: an equatorial ball can hold p while the
         // (obtuse) tet on its inner side does not have p in its circumsphere.
+        let mut sorted = removed.to_vec();
+        sorted.sort_unstable();
+        let in_removed = |t: u32| sorted.binary_search(&t).is_ok();
+        // (Ring tets may repeat: harmless, the checks below are idempotent.)
         let mut near: Vec<u32> = removed.to_vec();
         for &t in removed {
             for n in dom.dt.neighbors(t) {
-                if !removed.contains(&n) && !near.contains(&n) {
+                if !in_removed(n) {
                     near.push(n);
                 }
             }
@@ -354,7 +358,7 @@ impl<'a> Refiner<'a> {
                 if let Some(&fi) = dom.subfacets.get(&tri_key(f)) {
                     facets.push((fi, tri_key(f)));
                     let n = dom.dt.neighbors(t)[i];
-                    if in_cavity && removed.contains(&n) {
+                    if in_cavity && in_removed(n) {
                         crosses = true;
                         crossed = Some(Boundary::Facet(fi, tri_key(f)));
                     }

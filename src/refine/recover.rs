@@ -45,15 +45,24 @@ impl Domain {
             .chain(self.dt.last_removed().iter().copied())
             .collect();
         for v in quads {
+            // Only edges and faces whose vertices all lie on the boundary can be boundary
+            // elements; most tets have a volume vertex and are skipped without a lookup.
+            let on_boundary = v.map(|x| {
+                x != INFINITE && self.kind[x as usize] != super::domain::VertexKind::Volume
+            });
+            if on_boundary.iter().filter(|&&b| b).count() < 2 {
+                continue;
+            }
             for i in 0..4 {
                 for j in i + 1..4 {
                     let k = seg_key(v[i], v[j]);
-                    if self.subsegs.contains_key(&k) {
+                    if on_boundary[i] && on_boundary[j] && self.subsegs.contains_key(&k) {
                         self.dirty_segs.push(k);
                     }
                 }
                 let f = FACE[i].map(|l| v[l]);
-                if !f.contains(&INFINITE) && self.subfacets.contains_key(&tri_key(f)) {
+                let face_on_boundary = (0..4).all(|l| l == i || on_boundary[l]);
+                if face_on_boundary && self.subfacets.contains_key(&tri_key(f)) {
                     self.dirty_tris.push(tri_key(f));
                 }
             }
