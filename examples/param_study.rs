@@ -18,39 +18,48 @@ fn main() {
         "poly/two_materials.poly",
         "poly/drilled_block.poly",
     ];
-    let combos: &[(f64, f64, f64, f64)] = &[
-        (2.0, 0.0, 0.3, 4.0),
-        (2.0, 0.01, 0.3, 4.0),
-        (2.0, 0.02, 0.3, 4.0),
-        (2.0, 0.03, 0.3, 4.0),
-        (2.0, 0.04, 0.3, 4.0),
-        (2.0, 0.05, 0.3, 4.0),
-        (1.5, 0.03, 0.3, 4.0),
-        (2.0, 0.03, 0.1, 4.0),
-        (2.0, 0.03, 0.5, 4.0),
-        (2.0, 0.03, 0.3, 2.0),
-        (2.0, 0.03, 0.3, 8.0),
+    // (rho0, sigma0, min_dihedral, delta, b)
+    let combos: &[(f64, f64, f64, f64, f64)] = &[
+        (2.0, 0.0, 0.0, 0.3, 4.0),
+        (2.0, 0.02, 0.0, 0.3, 4.0),
+        (2.0, 0.05, 0.0, 0.3, 4.0),
+        (2.0, 0.08, 0.0, 0.3, 4.0),
+        (2.0, 0.02, 10.0, 0.3, 4.0),
+        (2.0, 0.02, 15.0, 0.3, 4.0),
+        (2.0, 0.02, 20.0, 0.3, 4.0),
+        (2.0, 0.02, 25.0, 0.3, 4.0),
+        (2.0, 0.02, 28.0, 0.3, 4.0),
+        (1.5, 0.02, 15.0, 0.3, 4.0),
+        (2.0, 0.02, 20.0, 0.1, 4.0),
+        (2.0, 0.02, 20.0, 0.5, 4.0),
+        (2.0, 0.02, 20.0, 0.3, 2.0),
+        (2.0, 0.02, 20.0, 0.3, 8.0),
+        (2.0, 0.02, 20.0, 0.3, 1.0), // b = 1: reject only very local slivers
     ];
     println!("size h = {size} (R <= h)\n");
-    println!("| model | rho0 | sigma0 | delta | b | vertices | tets | max rho | min sigma | min dihedral | complete | seconds |");
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("| model | rho0 | sigma0 | min dihedral bound | delta | b | vertices | tets | max rho | min sigma | min dihedral | complete | seconds |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for rel in inputs {
         let input = read_plc(&models.join(rel), &ReadOptions::default()).expect("read");
-        for &(rho0, sigma0, delta, b) in combos {
+        for &(rho0, sigma0, min_dihedral, delta, b) in combos {
             let params = Params {
                 rho0,
                 sigma0,
+                min_dihedral,
                 delta,
                 b,
+                max_vertices: 400_000,
                 ..Params::default()
             };
             let h = ConstantSpacing(size);
             match mesh(&input, &params, Some(&h), None) {
                 Ok((_, r)) => println!(
-                    "| {rel} | {rho0} | {sigma0} | {delta} | {b} | {} | {} | {:.3} | {:.4} | {:.2} | {} | {:.2} |",
+                    "| {rel} | {rho0} | {sigma0} | {min_dihedral} | {delta} | {b} | {} | {} | {:.3} | {:.4} | {:.2} | {} | {:.2} |",
                     r.n_vertices, r.n_tets, r.max_rho, r.min_sigma, r.min_dihedral_deg, r.complete, r.seconds_total
                 ),
-                Err(e) => println!("| {rel} | {rho0} | {sigma0} | {delta} | {b} | error: {e} |||||||"),
+                Err(e) => println!(
+                    "| {rel} | {rho0} | {sigma0} | {min_dihedral} | {delta} | {b} | error: {e} |||||||"
+                ),
             }
         }
     }

@@ -59,7 +59,7 @@ fn regions_and_holes() {
     assert!(rel_close(region_volume(&m, 2), 1.0, 1e-9));
     let m = conforming("poly/box_with_cavity.poly", Some(63.0));
     // The cavity [..] is removed: no tet centroid inside it.
-    assert!(m.tets.len() > 0);
+    assert!(!m.tets.is_empty());
 }
 
 #[test]

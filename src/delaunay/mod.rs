@@ -311,8 +311,8 @@ impl Delaunay {
             let t = star[k];
             k += 1;
             let tv = self.tets[t as usize].v;
-            for i in 0..4 {
-                if tv[i] == v {
+            for (i, &w) in tv.iter().enumerate() {
+                if w == v {
                     continue; // the face opposite v does not contain v
                 }
                 let n = self.tets[t as usize].n[i] >> 2;

@@ -30,6 +30,7 @@ impl Delaunay {
                     return Err(format!("tet {t} {v:?} is not positively oriented"));
                 }
             }
+            #[allow(clippy::needless_range_loop)] // i indexes FACE, the tet and its neighbours
             for i in 0..4 {
                 let r = self.tets[t as usize].n[i];
                 let (n, j) = (r >> 2, (r & 3) as usize);

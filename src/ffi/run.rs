@@ -22,7 +22,7 @@ pub unsafe extern "C" fn sm_refine(m: *mut sm_mesher) -> sm_status {
         st.stop_reason = None;
         let spacing = st.spacing_cb.as_ref().map(|s| s as &dyn Spacing);
         let progress_cb = st.progress_cb;
-        let mut relay = |fraction: f64, n: usize| progress_cb.map_or(true, |p| p.call(fraction, n));
+        let mut relay = |fraction: f64, n: usize| progress_cb.is_none_or(|p| p.call(fraction, n));
         let report = st.mesher.refine_with(spacing, Some(&mut relay))?;
         st.stop_reason = report
             .stop_reason

@@ -276,8 +276,8 @@ pub fn parse_msh(text: &str) -> Result<TetMesh, IoError> {
     let (mut surf, mut vol) = (Physicals::default(), Physicals::default());
     let mut nodes: Vec<(i64, usize, DVec3)> = Vec::new();
     // (element tag, line, node tags, (entity dimension, entity tag))
-    let mut tets: Vec<(i64, usize, [i64; 4], (usize, i64))> = Vec::new();
-    let mut tris: Vec<(i64, usize, [i64; 3], (usize, i64))> = Vec::new();
+    let mut tets: Vec<ElementRecord<4>> = Vec::new();
+    let mut tris: Vec<ElementRecord<3>> = Vec::new();
     while let Some((line, w)) = tok.next_opt() {
         let Some(name) = w.strip_prefix('$') else {
             return Err(err_at(
@@ -429,6 +429,9 @@ pub fn parse_msh(text: &str) -> Result<TetMesh, IoError> {
     }
     Ok(mesh)
 }
+
+/// (element tag, line, node tags, (entity dimension, entity tag)) of one parsed element.
+type ElementRecord<const N: usize> = (i64, usize, [i64; N], (usize, i64));
 
 #[cfg(test)]
 mod tests {

@@ -365,7 +365,7 @@ pub fn parse_vtu(text: &str) -> Result<VtuData, IoError> {
     let find = |section: &str, name: Option<&str>| {
         arrays
             .iter()
-            .find(|a| a.section == section && name.map_or(true, |n| a.name == n))
+            .find(|a| a.section == section && name.is_none_or(|n| a.name == n))
     };
     let pts = find("Points", None).ok_or_else(|| err_file("no Points DataArray"))?;
     if pts.components != 3 {

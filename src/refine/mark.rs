@@ -43,8 +43,7 @@ impl Domain {
                     touches_hull = true;
                 }
                 let nb = self.dt.neighbors(t);
-                for i in 0..4 {
-                    let n = nb[i];
+                for (i, &n) in nb.iter().enumerate() {
                     if comp[n as usize] == u32::MAX && !self.is_subfacet_face(t, i) {
                         comp[n as usize] = id;
                         stack.push(n);
