@@ -24,23 +24,7 @@ fn conforming(rel: &str, expected_volume: Option<f64>) -> slivermesh::TetMesh {
         ..Params::default()
     };
     let (m, report) = mesh(&input, &params, None, None).unwrap_or_else(|e| panic!("{rel}: {e}"));
-    check_orientation(&m);
-    check_delaunay(&m);
-    check_boundary_faces_are_tet_faces(&m);
-    let want = facet_area_by_marker(&input);
-    let got = boundary_area_by_marker(&m);
-    for (mk, a) in &want {
-        let g = got.get(mk).copied().unwrap_or(0.0);
-        assert!(
-            rel_close(g, *a, 1e-9),
-            "{rel}: marker {mk}: boundary area {g}, facets {a}"
-        );
-    }
-    assert_eq!(want.len(), got.len(), "{rel}: markers");
-    let vol = total_volume(&m);
-    if let Some(v) = expected_volume {
-        assert!(rel_close(vol, v, 1e-9), "{rel}: volume {vol}, expected {v}");
-    }
+    check_conforming(rel, &input, &m, expected_volume);
     assert_eq!(report.n_tets, m.tets.len());
     m
 }

@@ -44,22 +44,7 @@ fn refined(
     let input = read_model(rel);
     let (m, report) = mesh(&input, params, spacing, None).unwrap_or_else(|e| panic!("{rel}: {e}"));
     assert!(report.complete, "{rel}: {:?}", report.stop_reason);
-    check_orientation(&m);
-    check_delaunay(&m);
-    check_boundary_faces_are_tet_faces(&m);
-    let want = facet_area_by_marker(&input);
-    let got = boundary_area_by_marker(&m);
-    for (mk, a) in &want {
-        let g = got.get(mk).copied().unwrap_or(0.0);
-        assert!(
-            rel_close(g, *a, 1e-9),
-            "{rel}: marker {mk}: boundary area {g}, facets {a}"
-        );
-    }
-    if let Some(v) = volume {
-        let vol = total_volume(&m);
-        assert!(rel_close(vol, v, 1e-9), "{rel}: volume {vol}, expected {v}");
-    }
+    check_conforming(rel, &input, &m, volume);
     check_quality(rel, &m, params);
     m
 }

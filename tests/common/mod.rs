@@ -150,3 +150,25 @@ pub fn check_boundary_faces_are_tet_faces(m: &TetMesh) {
 pub fn rel_close(a: f64, b: f64, tol: f64) -> bool {
     (a - b).abs() <= tol * b.abs().max(1e-300)
 }
+
+/// The invariants every mesh of `input` must satisfy: positive orientation, Delaunay, boundary
+/// triangles are tet faces and tile each facet marker's area, the expected volume if known.
+pub fn check_conforming(rel: &str, input: &PlcInput, m: &TetMesh, volume: Option<f64>) {
+    check_orientation(m);
+    check_delaunay(m);
+    check_boundary_faces_are_tet_faces(m);
+    let want = facet_area_by_marker(input);
+    let got = boundary_area_by_marker(m);
+    for (mk, a) in &want {
+        let g = got.get(mk).copied().unwrap_or(0.0);
+        assert!(
+            rel_close(g, *a, 1e-9),
+            "{rel}: marker {mk}: boundary area {g}, facets {a}"
+        );
+    }
+    assert_eq!(want.len(), got.len(), "{rel}: markers");
+    if let Some(v) = volume {
+        let vol = total_volume(m);
+        assert!(rel_close(vol, v, 1e-9), "{rel}: volume {vol}, expected {v}");
+    }
+}
