@@ -182,3 +182,48 @@ fn acute_models_terminate_and_meet_bounds_away_from_small_angles() {
         );
     }
 }
+
+/// The paper's second input kind: an "almost good" Delaunay mesh with slivers (here
+/// two_materials.poly refined for size and radius-edge ratio only, written as medit .mesh and
+/// read back). Its boundary triangles
+/// (with markers) and regions are kept; afterwards every tet meets the bounds.
+#[test]
+fn slivers_of_an_existing_mesh_are_removed() {
+    let input = read_model("poly/two_materials.poly");
+    let almost_good = Params {
+        sigma0: 0.0,
+        min_dihedral: 0.0,
+        ..Params::default()
+    };
+    let (m0, _) = mesh(&input, &almost_good, Some(&ConstantSpacing(0.15)), None).unwrap();
+    let path =
+        std::env::temp_dir().join(format!("slivermesh-existing-{}.mesh", std::process::id()));
+    slivermesh::io::write_mesh(&path, &m0, &[]).unwrap();
+    let existing = slivermesh::io::read_mesh(&path).unwrap();
+    std::fs::remove_file(&path).ok();
+    let params = Params::default();
+    let (m, report) = slivermesh::refine::existing::remove_slivers(&existing, &params).unwrap();
+    assert!(report.complete, "{:?}", report.stop_reason);
+    check_orientation(&m);
+    check_delaunay(&m);
+    check_boundary_faces_are_tet_faces(&m);
+    check_quality("existing two_materials", &m, &params);
+    assert!(rel_close(total_volume(&m), 2.0, 1e-9));
+    assert!(rel_close(region_volume(&m, 1), 1.0, 1e-9));
+    assert!(rel_close(region_volume(&m, 2), 1.0, 1e-9));
+    let area = |mesh: &TetMesh| -> f64 { boundary_area_by_marker(mesh).values().sum() };
+    assert!(rel_close(area(&m), area(&existing), 1e-9));
+    // the input had flat tets, the output has none
+    let before = existing
+        .tets
+        .iter()
+        .map(|t| {
+            let [a, b, c, d] = t.map(|v| existing.vertices[v as usize]);
+            TetQuality::of(a, b, c, d).min_dihedral
+        })
+        .fold(180.0, f64::min);
+    assert!(
+        before < params.min_dihedral,
+        "the input already had no sliver: {before}"
+    );
+}

@@ -23,7 +23,7 @@ use crate::mesh::TetMesh;
 use crate::plc::PlcInput;
 use std::path::Path;
 
-pub mod coplanar;
+pub use crate::plc::coplanar;
 pub mod gmsh;
 pub mod medit;
 pub mod off;

@@ -10,7 +10,7 @@
 //!
 //! Each face becomes one facet with one polygon and marker = its 1-based facet index; with
 //! `ReadOptions::merge_coplanar` the facets are then merged by
-//! [`super::coplanar::merge_coplanar_facets`], which renumbers the markers the same way.
+//! [`crate::plc::coplanar::merge_coplanar_facets`], which renumbers the markers the same way.
 //! Not supported: binary OFF, 4D/nD OFF (`4OFF`, `nOFF`), vertex colours as data.
 
 use super::text::{err_at, read_text, to_u32, with_path, Lines};
@@ -95,7 +95,7 @@ fn parse_body(
     }
     lines.expect_end(&format!("the {nf} faces declared"))?;
     if options.merge_coplanar {
-        super::coplanar::merge_coplanar_facets(&mut plc);
+        crate::plc::coplanar::merge_coplanar_facets(&mut plc);
     }
     Ok(plc)
 }

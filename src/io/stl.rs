@@ -14,7 +14,7 @@
 //! whose corners merge into fewer than three distinct vertices are dropped. Each remaining
 //! triangle becomes a facet with marker = its 1-based facet index; with
 //! `ReadOptions::merge_coplanar` the facets are merged by
-//! [`super::coplanar::merge_coplanar_facets`], which renumbers markers the same way.
+//! [`crate::plc::coplanar::merge_coplanar_facets`], which renumbers markers the same way.
 //! Binary coordinates that are not finite are an error naming the triangle.
 
 use super::text::{err_at, err_file, read_bytes, with_path, Tokens};
@@ -66,7 +66,7 @@ pub fn parse_stl(bytes: &[u8], options: &ReadOptions) -> Result<PlcInput, IoErro
         })
         .collect();
     if options.merge_coplanar {
-        super::coplanar::merge_coplanar_facets(&mut plc);
+        crate::plc::coplanar::merge_coplanar_facets(&mut plc);
     }
     Ok(plc)
 }

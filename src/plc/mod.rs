@@ -11,6 +11,7 @@ use glam::DVec3;
 
 mod angles;
 mod cells;
+pub mod coplanar;
 mod error;
 mod exact;
 mod facet;

@@ -2,7 +2,7 @@
 //! Its boundary triangles become the facets, its vertices are all kept, its regions are
 //! re-seeded from one tet each, and refinement runs without a size bound.
 
-use super::{mesh, ConstantSpacing, MeshError, Params, Report};
+use super::{mesh_domain, ConstantSpacing, MeshError, Params, Report};
 use crate::mesh::TetMesh;
 use crate::plc::{Facet, PlcInput, Region};
 use glam::DVec3;
@@ -15,14 +15,18 @@ pub fn remove_slivers(existing: &TetMesh, params: &Params) -> Result<(TetMesh, R
             "the mesh has no boundary triangles: its boundary cannot be kept".into(),
         ));
     }
-    let input = plc_of_mesh(existing);
+    let mut input = plc_of_mesh(existing);
+    // Flat sides tiled by triangles become polygons again where they can (no vertex inside).
+    crate::plc::coplanar::merge_coplanar_facets(&mut input);
     let (lo, hi) = existing.vertices.iter().fold(
         (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)),
         |(l, h), &p| (l.min(p), h.max(p)),
     );
     // No size bound: a spacing far above the domain's size.
     let unbounded = ConstantSpacing(1e3 * (hi - lo).length().max(1e-300));
-    mesh(&input, params, Some(&unbounded), None)
+    // The angles between boundary triangles are not input features: shape bounds are
+    // enforced everywhere (the vertex budget still bounds the work).
+    mesh_domain(&input, params, Some(&unbounded), None, false)
 }
 
 fn plc_of_mesh(m: &TetMesh) -> PlcInput {

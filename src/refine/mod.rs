@@ -227,11 +227,25 @@ pub fn mesh(
     spacing: Option<&dyn Spacing>,
     progress: Option<Progress>,
 ) -> Result<(TetMesh, Report), MeshError> {
+    mesh_domain(input, params, spacing, progress, true)
+}
+
+/// [`mesh`], optionally treating every input angle as large: for the boundary of an existing
+/// mesh, whose flat sides are tiled by triangles meeting at angles that are not features.
+fn mesh_domain(
+    input: &PlcInput,
+    params: &Params,
+    spacing: Option<&dyn Spacing>,
+    progress: Option<Progress>,
+    respect_small_angles: bool,
+) -> Result<(TetMesh, Report), MeshError> {
     let start = std::time::Instant::now();
     params.check().map_err(MeshError::InvalidInput)?;
     let plc = crate::plc::validate(input).map_err(|e| MeshError::InvalidInput(e.to_string()))?;
     let mut dom = domain::Domain::new(input)?;
-    dom.set_acute_angles(&plc);
+    if respect_small_angles {
+        dom.set_acute_angles(&plc);
+    }
     let mut budget = recover::MAX_RECOVERY_SPLITS.min(params.max_vertices.saturating_mul(4));
     dom.recover_boundary(&mut budget)?;
     let mut regions = dom.mark_domain(input)?;
