@@ -276,25 +276,10 @@ impl Domain {
     fn splittable_point(&self, seg: u32, a: u32, b: u32, p: DVec3) -> DVec3 {
         let (pa, pb) = (self.point(a), self.point(b));
         let ok = |q: DVec3| {
-            self.segments[seg as usize].facets.iter().all(|&f| {
-                let fm = &self.facets[f as usize];
-                let n = fm.normal().abs();
-                let axis = if n.x >= n.y && n.x >= n.z {
-                    0
-                } else if n.y >= n.z {
-                    1
-                } else {
-                    2
-                };
-                let apexes = fm.opposite(a, b).into_iter().flatten().flatten();
-                apexes.into_iter().all(|c| {
-                    let pc = self.point(c);
-                    let s = orient_dropping(pa, pb, pc, axis);
-                    s != 0.0
-                        && orient_dropping(pa, q, pc, axis).signum() == s.signum()
-                        && orient_dropping(q, pb, pc, axis).signum() == s.signum()
-                })
-            })
+            self.segments[seg as usize]
+                .facets
+                .iter()
+                .all(|&f| self.facets[f as usize].can_split(a, b, q))
         };
         if ok(p) {
             return p;
@@ -349,11 +334,4 @@ fn acute_segment_vertices(points: &[DVec3], segments: &[Segment]) -> FxHashSet<u
         }
     }
     acute
-}
-
-/// Exact orientation of the projection of a, b, c dropping coordinate `axis` (sign only).
-fn orient_dropping(a: DVec3, b: DVec3, c: DVec3, axis: usize) -> f64 {
-    let (i, j) = ((axis + 1) % 3, (axis + 2) % 3);
-    let lift = |p: DVec3| DVec3::new(p[i], p[j], 0.0);
-    crate::geom::orient3d(lift(a), lift(b), lift(c), DVec3::Z)
 }

@@ -450,6 +450,27 @@ impl FacetMesh {
         Ok(self.finish(l, new, removed))
     }
 
+    /// Whether splitting edge ab at `p` would leave both adjacent triangles (inside or outside
+    /// the facet) positively oriented; false also when ab is not an edge.
+    pub fn can_split(&self, a: u32, b: u32, p: DVec3) -> bool {
+        self.facet_edge(a, b)
+            .is_some_and(|(t, i)| self.split_keeps_orientation(t, i, p))
+    }
+
+    fn split_keeps_orientation(&self, t: u32, i: usize, p: DVec3) -> bool {
+        let q = self.proj(p);
+        let tr = self.tris[t as usize];
+        let u = tr.n[i] / 3;
+        let ur = self.tris[u as usize];
+        let j = (tr.n[i] % 3) as usize;
+        let (c, x, y, d) = (tr.v[i], tr.v[nx(i)], tr.v[pv(i)], ur.v[j]);
+        let pp = |v: u32| self.p2[v as usize];
+        orient2d(pp(c), pp(x), q) > 0.0
+            && orient2d(pp(c), q, pp(y)) > 0.0
+            && orient2d(pp(d), pp(y), q) > 0.0
+            && orient2d(pp(d), q, pp(x)) > 0.0
+    }
+
     /// Splits the edge (a, b) (normally a subsegment) at vertex `id` placed at `p`, a point
     /// near the segment (a float midpoint: need not be exactly on it). The edge is replaced by
     /// a-p and p-b, both constrained if ab was; the one or two adjacent facet triangles are split,
@@ -462,20 +483,11 @@ impl FacetMesh {
             return Err(SplitError::NotFinite);
         }
         let (t, i) = self.facet_edge(a, b).ok_or(SplitError::NotAnEdge(a, b))?;
-        let q = self.proj(p);
-        let tr = self.tris[t as usize];
-        let u = tr.n[i] / 3;
-        let ur = self.tris[u as usize];
-        let j = (tr.n[i] % 3) as usize;
-        let (c, x, y, d) = (tr.v[i], tr.v[nx(i)], tr.v[pv(i)], ur.v[j]);
-        let pp = |v: u32| self.p2[v as usize];
-        let ok = orient2d(pp(c), pp(x), q) > 0.0
-            && orient2d(pp(c), q, pp(y)) > 0.0
-            && orient2d(pp(d), pp(y), q) > 0.0
-            && orient2d(pp(d), q, pp(x)) > 0.0;
-        if !ok {
+        if !self.split_keeps_orientation(t, i, p) {
             return Err(SplitError::WouldInvert);
         }
+        let tr = self.tris[t as usize];
+        let u = tr.n[i] / 3;
         let mut removed = Vec::new();
         for s in [t, u] {
             if self.tris[s as usize].inside() {
