@@ -175,15 +175,16 @@ pub fn insphere(a: DVec3, b: DVec3, c: DVec3, d: DVec3, e: DVec3) -> f64 {
     }
 }
 
-/// The semi-static filter of [`insphere`]: `Some(value)` when it decides the sign.
+/// The in-sphere determinant from the coordinate differences to e, ordered
+/// `[aex, bex, cex, dex, aey, .., dey, aez, .., dez]`, in Shewchuk's evaluation order. Shared by
+/// the float filter (its error bound is derived for exactly this sequence of operations) and the
+/// exact i128 lattice path.
 #[inline(always)]
-fn insphere_filter(a: DVec3, b: DVec3, c: DVec3, d: DVec3, e: DVec3) -> Option<f64> {
-    // Shewchuk's insphere evaluation with (pa, pb, pc, pd, pe) = (b, a, c, d, e): robust's
-    // insphere expects its own positive orientation (our negative one); swapping a and b
-    // turns our positive tet into robust's positive tet, and then > 0 means inside.
-    let (aex, bex, cex, dex) = (b.x - e.x, a.x - e.x, c.x - e.x, d.x - e.x);
-    let (aey, bey, cey, dey) = (b.y - e.y, a.y - e.y, c.y - e.y, d.y - e.y);
-    let (aez, bez, cez, dez) = (b.z - e.z, a.z - e.z, c.z - e.z, d.z - e.z);
+fn insphere_det<T>(d: [T; 12]) -> T
+where
+    T: Copy + std::ops::Add<Output = T> + std::ops::Sub<Output = T> + std::ops::Mul<Output = T>,
+{
+    let [aex, bex, cex, dex, aey, bey, cey, dey, aez, bez, cez, dez] = d;
     let ab = aex * bey - bex * aey;
     let bc = bex * cey - cex * bey;
     let cd = cex * dey - dex * cey;
@@ -199,6 +200,19 @@ fn insphere_filter(a: DVec3, b: DVec3, c: DVec3, d: DVec3, e: DVec3) -> Option<f
     let clift = cex * cex + cey * cey + cez * cez;
     let dlift = dex * dex + dey * dey + dez * dez;
     let det = (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
+    det
+}
+
+/// The semi-static filter of [`insphere`]: `Some(value)` when it decides the sign.
+#[inline(always)]
+fn insphere_filter(a: DVec3, b: DVec3, c: DVec3, d: DVec3, e: DVec3) -> Option<f64> {
+    // Shewchuk's insphere evaluation with (pa, pb, pc, pd, pe) = (b, a, c, d, e): robust's
+    // insphere expects its own positive orientation (our negative one); swapping a and b
+    // turns our positive tet into robust's positive tet, and then > 0 means inside.
+    let (aex, bex, cex, dex) = (b.x - e.x, a.x - e.x, c.x - e.x, d.x - e.x);
+    let (aey, bey, cey, dey) = (b.y - e.y, a.y - e.y, c.y - e.y, d.y - e.y);
+    let (aez, bez, cez, dez) = (b.z - e.z, a.z - e.z, c.z - e.z, d.z - e.z);
+    let det = insphere_det([aex, bex, cex, dex, aey, bey, cey, dey, aez, bez, cez, dez]);
     let mx = fmax(fmax(aex.abs(), bex.abs()), fmax(cex.abs(), dex.abs()));
     let my = fmax(fmax(aey.abs(), bey.abs()), fmax(cey.abs(), dey.abs()));
     let mz = fmax(fmax(aez.abs(), bez.abs()), fmax(cez.abs(), dez.abs()));
@@ -555,22 +569,7 @@ fn insphere_lattice(a: DVec3, b: DVec3, c: DVec3, d: DVec3, e: DVec3) -> Option<
         exact_diff(d.z, e.z)?,
     ];
     let (k, s) = lattice(diff, 24)?;
-    let [aex, bex, cex, dex, aey, bey, cey, dey, aez, bez, cez, dez] = k;
-    let ab = aex * bey - bex * aey;
-    let bc = bex * cey - cex * bey;
-    let cd = cex * dey - dex * cey;
-    let da = dex * aey - aex * dey;
-    let ac = aex * cey - cex * aey;
-    let bd = bex * dey - dex * bey;
-    let abc = aez * bc - bez * ac + cez * ab;
-    let bcd = bez * cd - cez * bd + dez * bc;
-    let cda = cez * da + dez * ac + aez * cd;
-    let dab = dez * ab + aez * bd + bez * da;
-    let alift = aex * aex + aey * aey + aez * aez;
-    let blift = bex * bex + bey * bey + bez * bez;
-    let clift = cex * cex + cey * cey + cez * cez;
-    let dlift = dex * dex + dey * dey + dez * dez;
-    let det = (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
+    let det = insphere_det(k);
     scaled(det, 5 * s)
 }
 
