@@ -48,31 +48,8 @@ enum Command {
         /// Write the mesh here.
         #[arg(short, long, value_name = "OUTPUT")]
         output: Option<PathBuf>,
-        /// Only recover the boundary (conforming Delaunay mesh, no quality refinement).
-        #[arg(long)]
-        no_refine: bool,
-        /// Constant spacing H (bounds every tet's circumradius); default: automatic, graded
-        /// from the input's local feature size.
-        #[arg(long, value_name = "H")]
-        size: Option<f64>,
-        /// Radius-edge bound rho0 (default 2).
-        #[arg(long, value_name = "R")]
-        rho: Option<f64>,
-        /// Sliver bound sigma0 = V / L^3 (default 0.02).
-        #[arg(long, value_name = "S")]
-        sigma: Option<f64>,
-        /// Smallest dihedral angle allowed, in degrees (default 15).
-        #[arg(long, value_name = "DEG")]
-        min_dihedral: Option<f64>,
-        /// Random seed (same input, parameters and seed: identical output).
-        #[arg(long, value_name = "N")]
-        seed: Option<u64>,
-        /// Stop refining at this many vertices (the report then says complete: false).
-        #[arg(long, value_name = "N")]
-        max_vertices: Option<usize>,
-        /// Keep .off/.stl triangles as separate facets instead of merging coplanar ones.
-        #[arg(long)]
-        no_merge: bool,
+        #[command(flatten)]
+        options: cli::mesh::MeshOptions,
         /// Write the report as JSON to this file.
         #[arg(long, value_name = "FILE")]
         stats_json: Option<PathBuf>,
@@ -109,28 +86,9 @@ fn main() -> ExitCode {
         Some(Command::Mesh {
             input,
             output,
-            no_refine,
-            size,
-            rho,
-            sigma,
-            min_dihedral,
-            seed,
-            max_vertices,
-            no_merge,
+            options,
             stats_json,
-        }) => {
-            let opts = cli::mesh::MeshOptions {
-                no_refine,
-                size,
-                rho,
-                sigma,
-                min_dihedral,
-                seed,
-                max_vertices,
-                no_merge,
-            };
-            cli::mesh::run_mesh(&input, output.as_deref(), stats_json.as_deref(), &opts)
-        }
+        }) => cli::mesh::run_mesh(&input, output.as_deref(), stats_json.as_deref(), &options),
         Some(Command::Delaunay {
             points,
             output,

@@ -11,15 +11,32 @@ use std::io::IsTerminal;
 use std::path::Path;
 
 /// Options of `slivermesh mesh` beyond the input and output paths.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, clap::Args)]
 pub struct MeshOptions {
+    /// Only recover the boundary (conforming Delaunay mesh, no quality refinement).
+    #[arg(long)]
     pub no_refine: bool,
+    /// Constant spacing H (bounds every tet's circumradius); default: automatic, graded
+    /// from the input's local feature size.
+    #[arg(long, value_name = "H")]
     pub size: Option<f64>,
+    /// Radius-edge bound rho0 (default 2).
+    #[arg(long, value_name = "R")]
     pub rho: Option<f64>,
+    /// Sliver bound sigma0 = V / L^3 (default 0.02).
+    #[arg(long, value_name = "S")]
     pub sigma: Option<f64>,
+    /// Smallest dihedral angle allowed, in degrees (default 15).
+    #[arg(long, value_name = "DEG")]
     pub min_dihedral: Option<f64>,
+    /// Random seed (same input, parameters and seed: identical output).
+    #[arg(long, value_name = "N")]
     pub seed: Option<u64>,
+    /// Stop refining at this many vertices (the report then says complete: false).
+    #[arg(long, value_name = "N")]
     pub max_vertices: Option<usize>,
+    /// Keep .off/.stl triangles as separate facets instead of merging coplanar ones.
+    #[arg(long)]
     pub no_merge: bool,
 }
 
@@ -79,7 +96,7 @@ pub fn run_mesh(
         .map_err(|e| e.to_string())?;
         mesh_with_progress(&plc, &params, spacing)?
     };
-    finish(&mesh, &report, spacing, output, stats_json)
+    finish(&mesh, &report, output, stats_json)
 }
 
 fn mesh_with_progress(
@@ -114,11 +131,9 @@ fn mesh_with_progress(
 fn finish(
     mesh: &TetMesh,
     report: &Report,
-    spacing: Option<&dyn Spacing>,
     output: Option<&Path>,
     stats_json: Option<&Path>,
 ) -> Result<(), String> {
-    let _ = spacing;
     println!("{}", report.table());
     if let Some(path) = stats_json {
         let json = serde_json::to_string_pretty(report).map_err(|e| e.to_string())?;
@@ -216,11 +231,5 @@ pub fn run_demo() -> Result<(), String> {
     let f = FnSpacing(|p: DVec3| 0.02 + 0.1 * p.length());
     let params = Params::default();
     let (mesh, report) = mesh_with_progress(&plc, &params, Some(&f))?;
-    finish(
-        &mesh,
-        &report,
-        Some(&f),
-        Some(Path::new("slivermesh-demo.vtu")),
-        None,
-    )
+    finish(&mesh, &report, Some(Path::new("slivermesh-demo.vtu")), None)
 }

@@ -199,8 +199,7 @@ where
     let blift = bex * bex + bey * bey + bez * bez;
     let clift = cex * cex + cey * cey + cez * cez;
     let dlift = dex * dex + dey * dey + dez * dez;
-    let det = (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
-    det
+    (dlift * abc - clift * dab) + (blift * cda - alift * bcd)
 }
 
 /// The semi-static filter of [`insphere`]: `Some(value)` when it decides the sign.

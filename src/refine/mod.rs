@@ -258,7 +258,6 @@ fn mesh_domain(
             &auto
         }
     };
-    let mut gave_up = 0;
     let mut stop_reason = None;
     if params.refine {
         let mut noop = |_: f64, _: usize| true;
@@ -273,7 +272,6 @@ fn mesh_domain(
             dom.created_log.clear();
             let mut r = quality::Refiner::new(&mut dom, params, spacing, &regions);
             r.run(&mut on_step)?;
-            gave_up = r.gave_up;
             stop_reason = r.stop_reason.take();
             // A boundary split can delete a subfacet of another facet for a moment, letting
             // region labels leak across it: check the whole boundary, re-mark from the seeds
@@ -293,7 +291,6 @@ fn mesh_domain(
     report.seconds_refinement = seconds_refinement;
     report.seconds_total = start.elapsed().as_secs_f64();
     report.n_acute_angles = dom.acute_vertices.len();
-    let _ = gave_up;
     report.n_bad_near_acute = bad_near_acute;
     report.complete = stop_reason.is_none() && (bad_elsewhere == 0 || !params.refine);
     if params.refine && stop_reason.is_none() && bad_elsewhere > 0 {
