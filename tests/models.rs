@@ -65,6 +65,7 @@ fn acute_off_models_conform() {
         "off/anchor.off",
         "off/rotor.off",
         "off/spool.off",
+        "off/part.off",
     ] {
         conforming(rel, None);
     }

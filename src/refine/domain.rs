@@ -49,6 +49,15 @@ pub struct Domain {
     pub acute_segments: FxHashSet<u32>,
     /// Input facets holding a small-angle vertex or segment.
     pub acute_facets: FxHashSet<u32>,
+    /// Protecting balls around the acute input vertices: vertex -> radius. Inside one,
+    /// boundary elements are split only when missing from the triangulation, not when merely
+    /// encroached (Pav & Walkington's protection): near an acute apex, splits encroach each
+    /// other's balls at every scale and would never stop.
+    pub protect_radius: FxHashMap<u32, f64>,
+    /// Per vertex: the acute input vertex whose protecting ball holds it, or `NO_APEX`.
+    pub apex: Vec<u32>,
+    /// Per facet: its acute input vertices.
+    facet_apexes: Vec<Vec<u32>>,
     /// Subsegments and subfacets to check for encroachment (see `recover::settle`).
     pub dirty_segs: Vec<(u32, u32)>,
     pub dirty_tris: Vec<[u32; 3]>,
@@ -60,6 +69,13 @@ pub struct Domain {
 /// "small": refinement does not enforce shape bounds next to them. Angles between 60 and 90
 /// degrees are acute too, but refinement terminates around them in practice (Shewchuk).
 pub const SMALL_ANGLE_DEG: f64 = 60.0;
+
+/// Protecting-ball radius as a fraction of the distance from an acute vertex to its nearest
+/// other input vertex (below one half, so that the balls of two vertices never overlap).
+pub const PROTECT_FRACTION: f64 = 0.4;
+
+/// `Domain::apex` of a vertex in no protecting ball.
+pub const NO_APEX: u32 = u32::MAX;
 
 pub fn seg_key(a: u32, b: u32) -> (u32, u32) {
     (a.min(b), a.max(b))
@@ -120,9 +136,36 @@ impl Domain {
             markers.push(f.marker);
         }
         let acute_vertices = acute_segment_vertices(&input.vertices, &segments);
+        let protect_radius: FxHashMap<u32, f64> = acute_vertices
+            .iter()
+            .map(|&v| (v, PROTECT_FRACTION * nearest_neighbor_distance(&dt, v)))
+            .collect();
+        let apex = (0..input.vertices.len() as u32)
+            .map(|v| {
+                if protect_radius.contains_key(&v) {
+                    v
+                } else {
+                    NO_APEX
+                }
+            })
+            .collect();
+        let facet_apexes = facets
+            .iter()
+            .map(|fm| {
+                let mut a: Vec<u32> = fm
+                    .vertices()
+                    .filter(|v| protect_radius.contains_key(v))
+                    .collect();
+                a.sort_unstable();
+                a
+            })
+            .collect();
         Ok(Domain {
             dt,
             kind: vec![VertexKind::Input; input.vertices.len()],
+            protect_radius,
+            apex,
+            facet_apexes,
             subsegs: seg_index,
             segments,
             facets,
@@ -186,6 +229,31 @@ impl Domain {
         }
     }
 
+    /// The acute input vertex whose protecting ball holds a new boundary point `p` (the
+    /// nearest, if several), or `NO_APEX`. Volume points are never protected.
+    fn apex_of(&self, p: DVec3, kind: VertexKind) -> u32 {
+        let candidates: &[u32] = match kind {
+            VertexKind::Segment(s) => &self.segments[s as usize].ends,
+            VertexKind::Facet(f) => &self.facet_apexes[f as usize],
+            VertexKind::Input | VertexKind::Volume => &[],
+        };
+        candidates
+            .iter()
+            .filter_map(|&v| {
+                let r = *self.protect_radius.get(&v)?;
+                let d = self.point(v).distance(p);
+                (d < r).then_some((d, v))
+            })
+            .min_by(|x, y| x.0.total_cmp(&y.0))
+            .map_or(NO_APEX, |(_, v)| v)
+    }
+
+    /// Whether all of `verts` lie in one protecting ball (see `protect_radius`).
+    pub fn protected(&self, verts: &[u32]) -> bool {
+        let a = self.apex[verts[0] as usize];
+        a != NO_APEX && verts.iter().all(|&v| self.apex[v as usize] == a)
+    }
+
     pub fn point(&self, v: u32) -> DVec3 {
         self.dt.point(v)
     }
@@ -199,7 +267,9 @@ impl Domain {
     ) -> Result<u32, MeshError> {
         match self.dt.insert(p, hint) {
             Ok(Inserted::New(id)) => {
+                let apex = self.apex_of(p, kind);
                 self.kind.push(kind);
+                self.apex.push(apex);
                 self.queue_around_last_insertion();
                 self.created_log.extend_from_slice(self.dt.last_created());
                 Ok(id)
@@ -310,6 +380,17 @@ impl Domain {
         self.apply_change(f, &change);
         Ok(id)
     }
+}
+
+/// Distance from vertex `v` to its nearest neighbour (one of its Delaunay neighbours).
+fn nearest_neighbor_distance(dt: &Delaunay, v: u32) -> f64 {
+    let p = dt.point(v);
+    dt.vertex_star(v)
+        .into_iter()
+        .flat_map(|t| dt.tet(t))
+        .filter(|&w| w != v && w != crate::delaunay::INFINITE)
+        .map(|w| dt.point(w).distance(p))
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// Input vertices where two segments meet at less than 90 degrees.

@@ -113,7 +113,7 @@ impl Domain {
             }
             for &w in &v {
                 if w != a && w != b && w != INFINITE && self.point(w).distance_squared(c) < r2 {
-                    return Status::Encroached;
+                    return self.encroached_unless_protected(&[a, b]);
                 }
             }
         }
@@ -133,10 +133,19 @@ impl Domain {
         for (tet, i) in sides {
             let apex = self.dt.tet(tet)[i];
             if apex != INFINITE && self.point(apex).distance_squared(c) < r * r {
-                return Status::Encroached;
+                return self.encroached_unless_protected(&t);
             }
         }
         Status::Ok
+    }
+
+    /// Inside a protecting ball an encroached element that is present is left alone.
+    fn encroached_unless_protected(&self, verts: &[u32]) -> Status {
+        if self.protected(verts) {
+            Status::Ok
+        } else {
+            Status::Encroached
+        }
     }
 
     /// A subfacet can be missing only because the 3D triangulation broke a cocircular tie the
