@@ -218,6 +218,22 @@ fn interface_triangles_are_kept_or_recovered() {
         &listed,
     );
 
+    // The interface listed twice (the copy reversed, another marker): the first one counts.
+    let mut twice = full.clone();
+    for i in 0..full.boundary.len() {
+        if full.boundary_markers[i] == 2 {
+            let [a, b, c] = full.boundary[i];
+            twice.boundary.push([a, c, b]);
+            twice.boundary_markers.push(9);
+        }
+    }
+    let (m, _) = remove_and_check(&twice);
+    assert_close_maps(
+        "boundary area of marker",
+        &boundary_area_by_marker(&m),
+        &listed,
+    );
+
     // The interface (marker 2) left out of the file: recovered with marker 0.
     let mut no_interface = full.clone();
     let keep: Vec<usize> = (0..full.boundary.len())

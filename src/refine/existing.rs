@@ -352,3 +352,82 @@ impl UnionFind {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The unit square in z = 0.
+    fn square() -> Vec<DVec3> {
+        vec![
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+        ]
+    }
+
+    #[test]
+    fn flat_patch_with_one_marker_is_merged_keeping_it() {
+        // (0,3,2) is the other orientation: reoriented before merging.
+        let f = merge_flat_patches(&square(), vec![([0, 1, 2], 5), ([0, 3, 2], 5)]);
+        assert_eq!(f.len(), 1);
+        assert_eq!(f[0].polygons[0].len(), 4);
+        assert_eq!(f[0].marker, 5);
+    }
+
+    #[test]
+    fn marker_change_is_not_merged() {
+        let f = merge_flat_patches(&square(), vec![([0, 1, 2], 5), ([0, 2, 3], 6)]);
+        let markers: Vec<i32> = f.iter().map(|f| f.marker).collect();
+        assert_eq!(markers, vec![5, 6]);
+    }
+
+    /// A flat ring: the 3x3 grid of unit squares in z = 0 without its centre, two triangles per
+    /// square (vertex j * 4 + i at (i, j)), marker 5.
+    fn ring() -> (Vec<DVec3>, Vec<([u32; 3], i32)>) {
+        let mut v = vec![];
+        for j in 0..4 {
+            for i in 0..4 {
+                v.push(DVec3::new(i as f64, j as f64, 0.0));
+            }
+        }
+        let mut t = vec![];
+        for j in 0..3u32 {
+            for i in 0..3u32 {
+                if (i, j) != (1, 1) {
+                    let a = j * 4 + i;
+                    t.push(([a, a + 1, a + 5], 5));
+                    t.push(([a, a + 5, a + 4], 5));
+                }
+            }
+        }
+        (v, t)
+    }
+
+    #[test]
+    fn fin_across_a_flat_ring_is_not_merged_away() {
+        let (mut v, mut t) = ring();
+        assert_eq!(merge_flat_patches(&v, t.clone()).len(), 1);
+        // A fin on edge (1, 5), from the outer to the inner boundary: the ring is still one
+        // patch, but merging it would drop that edge. It stays as triangles.
+        v.push(DVec3::new(1.0, 0.5, 1.0));
+        t.push(([1, 5, 16], 7));
+        let f = merge_flat_patches(&v, t);
+        assert_eq!(f.len(), 17);
+        assert!(f.iter().all(|f| f.polygons[0].len() == 3));
+    }
+
+    #[test]
+    fn seed_strictly_inside() {
+        let p = [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z];
+        assert!(strictly_inside(p, DVec3::splat(0.25)));
+        assert!(strictly_inside(
+            [p[1], p[0], p[2], p[3]],
+            DVec3::splat(0.25)
+        ));
+        assert!(!strictly_inside(p, DVec3::new(0.25, 0.25, 0.0)));
+        let flat = [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(1.0, 1.0, 0.0)];
+        assert!(!strictly_inside(flat, DVec3::new(0.5, 0.5, 0.0)));
+    }
+}
