@@ -211,8 +211,16 @@ fn slivers_of_an_existing_mesh_are_removed() {
     assert!(rel_close(total_volume(&m), 2.0, 1e-9));
     assert!(rel_close(region_volume(&m, 1), 1.0, 1e-9));
     assert!(rel_close(region_volume(&m, 2), 1.0, 1e-9));
-    let area = |mesh: &TetMesh| -> f64 { boundary_area_by_marker(mesh).values().sum() };
-    assert!(rel_close(area(&m), area(&existing), 1e-9));
+    // boundary and interface area per marker
+    let (got, want) = (
+        boundary_area_by_marker(&m),
+        boundary_area_by_marker(&existing),
+    );
+    assert_eq!(got.len(), want.len(), "markers {got:?} vs {want:?}");
+    for (mk, a) in &want {
+        let g = got.get(mk).copied().unwrap_or(0.0);
+        assert!(rel_close(g, *a, 1e-9), "marker {mk}: area {g}, input {a}");
+    }
     // the input had flat tets, the output has none
     let before = existing
         .tets

@@ -1,7 +1,7 @@
 //! Domain marking: split the triangulation into components bounded by subfacets, drop the
-//! ones touching the hull or holding a hole seed, and give each the attribute of its region
-//! seed. Each tet's kernel tag names its component (0 = outside), so tets created later
-//! inherit it.
+//! ones touching the hull or holding a hole seed (and, for an existing mesh, the ones without
+//! a region seed), and give each the attribute of its region seed. Each tet's kernel tag names
+//! its component (0 = outside), so tets created later inherit it.
 
 use super::domain::{tri_key, Domain};
 use super::MeshError;
@@ -15,6 +15,15 @@ pub struct Regions {
     pub max_size: Vec<Option<f64>>,
 }
 
+/// What a component without a region seed becomes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Unseeded {
+    /// Part of the domain, with attribute 0 (a PLC: seeds are optional).
+    Domain,
+    /// A hole (an existing mesh: it seeds every piece it has tets in).
+    Hole,
+}
+
 impl Domain {
     /// Whether face `i` of tet `t` is a subfacet.
     pub fn is_subfacet_face(&self, t: u32, i: usize) -> bool {
@@ -23,7 +32,11 @@ impl Domain {
         !f.contains(&INFINITE) && self.subfacets.contains_key(&tri_key(f))
     }
 
-    pub fn mark_domain(&mut self, input: &PlcInput) -> Result<Regions, MeshError> {
+    pub fn mark_domain(
+        &mut self,
+        input: &PlcInput,
+        unseeded: Unseeded,
+    ) -> Result<Regions, MeshError> {
         let cap = self.dt.tet_capacity();
         let mut comp = vec![u32::MAX; cap];
         let mut outside = vec![];
@@ -76,6 +89,11 @@ impl Domain {
             }
             attribute[c] = Some(r.attribute);
             max_size[c] = r.max_size.filter(|&s| s > 0.0);
+        }
+        if unseeded == Unseeded::Hole {
+            for (out, a) in outside.iter_mut().zip(&attribute) {
+                *out |= a.is_none();
+            }
         }
         // Tags: 0 outside, then one per inside component.
         let mut tag_of = vec![0u32; n_comp as usize];

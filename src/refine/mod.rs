@@ -17,6 +17,7 @@ pub use spacing::AutoSpacing;
 use crate::mesh::TetMesh;
 use crate::plc::PlcInput;
 use glam::DVec3;
+use mark::Unseeded;
 
 /// Refinement parameters (names follow the paper).
 #[derive(Debug, Clone, PartialEq)]
@@ -227,17 +228,20 @@ pub fn mesh(
     spacing: Option<&dyn Spacing>,
     progress: Option<Progress>,
 ) -> Result<(TetMesh, Report), MeshError> {
-    mesh_domain(input, params, spacing, progress, true)
+    mesh_domain(input, params, spacing, progress, true, Unseeded::Domain)
 }
 
-/// [`mesh`], optionally treating every input angle as large: for the boundary of an existing
-/// mesh, whose flat sides are tiled by triangles meeting at angles that are not features.
+/// [`mesh`], optionally treating every input angle as large (for the boundary of an existing
+/// mesh, whose flat sides are tiled by triangles meeting at angles that are not features), and
+/// with a choice for components without a region seed (an existing mesh seeds all its pieces:
+/// the others are holes).
 fn mesh_domain(
     input: &PlcInput,
     params: &Params,
     spacing: Option<&dyn Spacing>,
     progress: Option<Progress>,
     respect_small_angles: bool,
+    unseeded: Unseeded,
 ) -> Result<(TetMesh, Report), MeshError> {
     let start = std::time::Instant::now();
     params.check().map_err(MeshError::InvalidInput)?;
@@ -248,7 +252,7 @@ fn mesh_domain(
     }
     let mut budget = recover::MAX_RECOVERY_SPLITS.min(params.max_vertices.saturating_mul(4));
     dom.recover_boundary(&mut budget)?;
-    let mut regions = dom.mark_domain(input)?;
+    let mut regions = dom.mark_domain(input, unseeded)?;
     let seconds_recovery = start.elapsed().as_secs_f64();
     let auto;
     let spacing: &dyn Spacing = match spacing {
@@ -277,7 +281,7 @@ fn mesh_domain(
             // region labels leak across it: check the whole boundary, re-mark from the seeds
             // and look at every tet again until a pass changes nothing.
             dom.recover_boundary(&mut budget)?;
-            regions = dom.mark_domain(input)?;
+            regions = dom.mark_domain(input, unseeded)?;
             if stop_reason.is_some() || dom.dt.num_vertices() == before {
                 break;
             }
