@@ -302,38 +302,58 @@ impl Delaunay {
 
     /// All alive tets incident to vertex `v` (hull tets included).
     pub fn vertex_star(&self, v: u32) -> Vec<u32> {
-        let Some(start) = self.vertex_tet(v) else {
-            return vec![];
-        };
+        let mut star = vec![];
+        self.search_star(v, |t| {
+            star.push(t);
+            false
+        });
+        star
+    }
+
+    /// Visits the tets incident to vertex `v` (breadth first from `vertex_tet(v)`) until
+    /// `found` says stop; returns that tet.
+    fn search_star(&self, v: u32, mut found: impl FnMut(u32) -> bool) -> Option<u32> {
+        let start = self.vertex_tet(v)?;
         let mut star = vec![start];
+        // Small stars: a linear scan is fastest; large ones (an apex of many subsegments can
+        // hold thousands of tets) need a set, or the search is quadratic.
+        let mut seen: Option<rustc_hash::FxHashSet<u32>> = None;
         let mut k = 0;
         while k < star.len() {
             let t = star[k];
             k += 1;
+            if found(t) {
+                return Some(t);
+            }
             let tv = self.tets[t as usize].v;
             for (i, &w) in tv.iter().enumerate() {
                 if w == v {
                     continue; // the face opposite v does not contain v
                 }
                 let n = self.tets[t as usize].n[i] >> 2;
-                if !star.contains(&n) {
+                let new = match &mut seen {
+                    Some(set) => set.insert(n),
+                    None => !star.contains(&n),
+                };
+                if new {
                     star.push(n);
+                    if seen.is_none() && star.len() > 48 {
+                        seen = Some(star.iter().copied().collect());
+                    }
                 }
             }
         }
-        star
+        None
     }
 
     /// A tet having both `a` and `b` as vertices (i.e. edge ab exists), if any.
     pub fn find_edge(&self, a: u32, b: u32) -> Option<u32> {
-        self.vertex_star(a)
-            .into_iter()
-            .find(|&t| self.tets[t as usize].v.contains(&b))
+        self.search_star(a, |t| self.tets[t as usize].v.contains(&b))
     }
 
     /// The tets (one or two) having face abc, with the local index of their fourth vertex.
     pub fn find_face(&self, a: u32, b: u32, c: u32) -> Option<[(u32, usize); 2]> {
-        let t = self.vertex_star(a).into_iter().find(|&t| {
+        let t = self.search_star(a, |t| {
             let v = self.tets[t as usize].v;
             v.contains(&b) && v.contains(&c)
         })?;

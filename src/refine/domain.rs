@@ -136,36 +136,12 @@ impl Domain {
             markers.push(f.marker);
         }
         let acute_vertices = acute_segment_vertices(&input.vertices, &segments);
-        let protect_radius: FxHashMap<u32, f64> = acute_vertices
-            .iter()
-            .map(|&v| (v, PROTECT_FRACTION * nearest_neighbor_distance(&dt, v)))
-            .collect();
-        let apex = (0..input.vertices.len() as u32)
-            .map(|v| {
-                if protect_radius.contains_key(&v) {
-                    v
-                } else {
-                    NO_APEX
-                }
-            })
-            .collect();
-        let facet_apexes = facets
-            .iter()
-            .map(|fm| {
-                let mut a: Vec<u32> = fm
-                    .vertices()
-                    .filter(|v| protect_radius.contains_key(v))
-                    .collect();
-                a.sort_unstable();
-                a
-            })
-            .collect();
         Ok(Domain {
             dt,
             kind: vec![VertexKind::Input; input.vertices.len()],
-            protect_radius,
-            apex,
-            facet_apexes,
+            protect_radius: FxHashMap::default(),
+            apex: vec![NO_APEX; input.vertices.len()],
+            facet_apexes: vec![vec![]; input.facets.len()],
             subsegs: seg_index,
             segments,
             facets,
@@ -181,8 +157,23 @@ impl Domain {
         })
     }
 
-    /// Records the small input angles the validator found (see `near_acute`).
+    /// Records the small input angles the validator found (see `near_acute`) and puts a
+    /// protecting ball around every acute input vertex (see `protect_radius`). Not called for
+    /// the boundary of an existing mesh, whose angles are not features.
     pub fn set_acute_angles(&mut self, plc: &crate::plc::Plc) {
+        for &v in &self.acute_vertices {
+            let r = PROTECT_FRACTION * nearest_neighbor_distance(&self.dt, v);
+            self.protect_radius.insert(v, r);
+            self.apex[v as usize] = v;
+        }
+        for (f, fm) in self.facets.iter().enumerate() {
+            let apexes = &mut self.facet_apexes[f];
+            apexes.extend(
+                fm.vertices()
+                    .filter(|v| self.protect_radius.contains_key(v)),
+            );
+            apexes.sort_unstable();
+        }
         let acute = plc.acute_angles();
         for a in acute
             .segment_angles
@@ -218,9 +209,16 @@ impl Domain {
         }
     }
 
-    /// Whether vertex `v` lies on an input feature with an acute angle, where quality cannot
-    /// always be enforced without an endless cascade of boundary splits.
+    /// Whether vertex `v` is within the influence of a small input angle, where quality
+    /// cannot always be enforced without an endless cascade of boundary splits: in the
+    /// protecting ball of a vertex where segments meet at a small angle, on a segment in a
+    /// small angle (between facets, or ending at a small-angle vertex) or on a facet holding
+    /// one.
     pub fn near_acute(&self, v: u32) -> bool {
+        let apex = self.apex[v as usize];
+        if apex != NO_APEX && self.small_angle_vertices.contains(&apex) {
+            return true;
+        }
         match self.kind[v as usize] {
             VertexKind::Input => self.small_angle_vertices.contains(&v),
             VertexKind::Segment(s) => self.acute_segments.contains(&s),
@@ -248,10 +246,26 @@ impl Domain {
             .map_or(NO_APEX, |(_, v)| v)
     }
 
-    /// Whether all of `verts` lie in one protecting ball (see `protect_radius`).
+    /// Whether vertex `v` is within the influence of an acute input angle: next to a small
+    /// one (`near_acute`) or in the protecting ball of an acute input vertex, where boundary
+    /// elements may stay encroached.
+    pub fn influenced_by_acute_angle(&self, v: u32) -> bool {
+        self.near_acute(v) || self.apex[v as usize] != NO_APEX
+    }
+
+    /// Whether the boundary element with vertices `verts` is exempt from splitting for
+    /// encroachment alone during boundary recovery: all of them lie in one protecting ball
+    /// (see `protect_radius`), or it is near a small angle (`near_acute_element`).
     pub fn protected(&self, verts: &[u32]) -> bool {
         let a = self.apex[verts[0] as usize];
-        a != NO_APEX && verts.iter().all(|&v| self.apex[v as usize] == a)
+        (a != NO_APEX && verts.iter().all(|&v| self.apex[v as usize] == a))
+            || self.near_acute_element(verts)
+    }
+
+    /// Whether a boundary element with vertices `verts` touches a feature with a small angle,
+    /// where quality is not enforced and splits would encroach each other without end.
+    pub fn near_acute_element(&self, verts: &[u32]) -> bool {
+        verts.iter().any(|&v| self.near_acute(v))
     }
 
     pub fn point(&self, v: u32) -> DVec3 {
@@ -373,10 +387,21 @@ impl Domain {
         p: DVec3,
         hint: Option<u32>,
     ) -> Result<u32, MeshError> {
+        // Checked before the 3D insertion so that a refusal leaves both triangulations as
+        // they were.
+        self.facets[f as usize].can_insert(p).map_err(|e| {
+            MeshError::Internal(format!(
+                "facet {f}: point ({}, {}, {}) refused: {e:?}",
+                p.x, p.y, p.z
+            ))
+        })?;
         let id = self.insert_point(p, VertexKind::Facet(f), hint)?;
-        let change = self.facets[f as usize]
-            .insert(id, p)
-            .map_err(|_| MeshError::Internal(format!("facet {f}: split point left the facet")))?;
+        let change = self.facets[f as usize].insert(id, p).map_err(|e| {
+            MeshError::Internal(format!(
+                "facet {f}: point ({}, {}, {}) not inserted: {e:?}",
+                p.x, p.y, p.z
+            ))
+        })?;
         self.apply_change(f, &change);
         Ok(id)
     }

@@ -417,6 +417,65 @@ impl FacetMesh {
         if id == NONE || self.local.contains_key(&id) {
             return Err(InsertError::IdInUse(id));
         }
+        let (t, i) = self.insertion_place(p)?;
+        let tr = self.tris[t as usize];
+        let mut removed = vec![self.gtri(t)];
+        if i < 3 {
+            removed.push(self.gtri(tr.n[i] / 3));
+        }
+        let loc = if i < 3 { Loc::Edge(t, i) } else { Loc::In(t) };
+        let (l, new) = self.place(loc, id, p);
+        self.n_inside += 2;
+        Ok(self.finish(l, new, removed))
+    }
+
+    /// Walking in a straight line from the centroid of facet triangle `tri` (global ids)
+    /// towards `p`, the first constrained edge crossed (global ids), if the line leaves through
+    /// one before reaching `p`. This is the subsegment to split when a subfacet's circumcentre
+    /// lies beyond the facet's boundary (Ruppert's rule, without assuming the subsegment is
+    /// encroached).
+    pub fn constrained_edge_towards(&self, tri: [u32; 3], p: DVec3) -> Option<[u32; 2]> {
+        let (t0, i0) = self.facet_edge(tri[0], tri[1])?;
+        let apex = *self.local.get(&tri[2])?;
+        let t0 = if self.tris[t0 as usize].find(apex).is_some() {
+            t0
+        } else {
+            self.tris[t0 as usize].n[i0] / 3
+        };
+        self.tris[t0 as usize].find(apex)?;
+        let target = self.proj(p);
+        let tr = self.tris[t0 as usize];
+        let start = tr.v.iter().map(|&v| self.p2[v as usize]).sum::<DVec2>() / 3.0;
+        let mut t = t0;
+        for _ in 0..self.tris.len() {
+            let tr = self.tris[t as usize];
+            // Leave through edge i when the target is strictly beyond it and the line from
+            // the start crosses it.
+            let exit = (0..3).find(|&i| {
+                let (x, y) = (self.p2[tr.v[nx(i)] as usize], self.p2[tr.v[pv(i)] as usize]);
+                orient2d(x, y, target) < 0.0
+                    && orient2d(start, target, x) <= 0.0
+                    && orient2d(start, target, y) >= 0.0
+            })?;
+            if tr.cons(exit) {
+                return Some(self.edge_ids(&tr, exit));
+            }
+            let r = tr.n[exit];
+            if r == NONE {
+                return None;
+            }
+            t = r / 3;
+        }
+        None
+    }
+
+    /// Whether [`FacetMesh::insert`] would accept `p` (the same checks, nothing changes).
+    pub fn can_insert(&self, p: DVec3) -> Result<(), InsertError> {
+        self.insertion_place(p).map(|_| ())
+    }
+
+    /// Where `p` would be inserted: (triangle, edge index or 3 for its interior).
+    fn insertion_place(&self, p: DVec3) -> Result<(u32, usize), InsertError> {
         if !p.is_finite() {
             return Err(InsertError::NotFinite);
         }
@@ -441,13 +500,7 @@ impl FacetMesh {
         if !tr.inside() {
             return Err(InsertError::Outside);
         }
-        let mut removed = vec![self.gtri(t)];
-        if i < 3 {
-            removed.push(self.gtri(tr.n[i] / 3));
-        }
-        let (l, new) = self.place(loc, id, p);
-        self.n_inside += 2;
-        Ok(self.finish(l, new, removed))
+        Ok((t, i))
     }
 
     /// Whether splitting edge ab at `p` would leave both adjacent triangles (inside or outside

@@ -18,6 +18,7 @@ use crate::mesh::TetMesh;
 use crate::plc::PlcInput;
 use glam::DVec3;
 use mark::Unseeded;
+use rustc_hash::FxHashSet;
 
 /// Refinement parameters (names follow the paper).
 #[derive(Debug, Clone, PartialEq)]
@@ -193,8 +194,14 @@ impl std::fmt::Display for MeshError {
 impl std::error::Error for MeshError {}
 
 /// Final tets violating rho0, sigma0 or min_dihedral: (within the influence of an acute
-/// input angle, elsewhere).
-fn count_bad(dom: &domain::Domain, mesh: &TetMesh, params: &Params) -> (usize, usize) {
+/// input angle — a vertex next to a small angle or in the protecting ball of an acute input
+/// vertex —, elsewhere).
+fn count_bad(
+    dom: &domain::Domain,
+    mesh: &TetMesh,
+    params: &Params,
+    blocked: &FxHashSet<[u32; 4]>,
+) -> (usize, usize) {
     let mut near = 0;
     let mut other = 0;
     for t in &mesh.tets {
@@ -203,7 +210,9 @@ fn count_bad(dom: &domain::Domain, mesh: &TetMesh, params: &Params) -> (usize, u
         let bad =
             q.rho > params.rho0 || q.sigma < params.sigma0 || q.min_dihedral < params.min_dihedral;
         if bad {
-            if t.iter().any(|&v| dom.near_acute(v)) {
+            if t.iter().any(|&v| dom.influenced_by_acute_angle(v))
+                || blocked.contains(&quality::sorted4(*t))
+            {
                 near += 1;
             } else {
                 other += 1;
@@ -263,6 +272,7 @@ fn mesh_domain(
         }
     };
     let mut stop_reason = None;
+    let mut blocked = FxHashSet::default();
     if params.refine {
         let mut noop = |_: f64, _: usize| true;
         let progress: &mut dyn FnMut(f64, usize) -> bool = match progress {
@@ -277,6 +287,7 @@ fn mesh_domain(
             let mut r = quality::Refiner::new(&mut dom, params, spacing, &regions);
             r.run(&mut on_step)?;
             stop_reason = r.stop_reason.take();
+            blocked.extend(r.blocked_by_small_angle.drain());
             // A boundary split can delete a subfacet of another facet for a moment, letting
             // region labels leak across it: check the whole boundary, re-mark from the seeds
             // and look at every tet again until a pass changes nothing.
@@ -290,7 +301,7 @@ fn mesh_domain(
     let seconds_refinement = start.elapsed().as_secs_f64() - seconds_recovery;
     let mesh = dom.to_mesh(&regions);
     let mut report = report::measure(&mesh, spacing, params)?;
-    let (bad_near_acute, bad_elsewhere) = count_bad(&dom, &mesh, params);
+    let (bad_near_acute, bad_elsewhere) = count_bad(&dom, &mesh, params, &blocked);
     report.seconds_recovery = seconds_recovery;
     report.seconds_refinement = seconds_refinement;
     report.seconds_total = start.elapsed().as_secs_f64();

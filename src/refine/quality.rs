@@ -13,6 +13,7 @@ use crate::geom::{diametric_ball, equatorial_ball, tri_circumcenter};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use rustc_hash::FxHashSet;
 use std::cmp::Ordering;
 use std::collections::VecDeque;
 
@@ -66,9 +67,26 @@ pub struct Refiner<'a> {
     /// Bad tets left alone because fixing them needed an ever smaller boundary split (the
     /// signature of an acute input angle).
     pub gave_up: usize,
+    /// Bad tets (vertex quadruples) left alone because fixing them needed a split of a
+    /// boundary element next to a small input angle: they are within its influence.
+    pub blocked_by_small_angle: FxHashSet<[u32; 4]>,
     pub stop_reason: Option<String>,
     /// cos(params.min_dihedral): a tet whose largest dihedral cosine exceeds it is a sliver.
     cos_min_dihedral: f64,
+    /// The bounding box of the input vertices.
+    domain_box: BoundingBox,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct BoundingBox {
+    lo: DVec3,
+    hi: DVec3,
+}
+
+impl BoundingBox {
+    fn contains(&self, p: DVec3) -> bool {
+        p.cmpge(self.lo).all() && p.cmple(self.hi).all()
+    }
 }
 
 impl<'a> Refiner<'a> {
@@ -78,6 +96,15 @@ impl<'a> Refiner<'a> {
         spacing: &'a dyn Spacing,
         regions: &'a Regions,
     ) -> Self {
+        let n_input = dom
+            .kind
+            .iter()
+            .take_while(|k| **k == VertexKind::Input)
+            .count();
+        let (lo, hi) = dom.dt.points()[..n_input].iter().fold(
+            (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)),
+            |(l, h), &p| (l.min(p), h.max(p)),
+        );
         Refiner {
             rng: ChaCha8Rng::seed_from_u64(params.seed),
             dom,
@@ -86,8 +113,10 @@ impl<'a> Refiner<'a> {
             regions,
             queues: Default::default(),
             gave_up: 0,
+            blocked_by_small_angle: FxHashSet::default(),
             stop_reason: None,
             cos_min_dihedral: params.min_dihedral.to_radians().cos(),
+            domain_box: BoundingBox { lo, hi },
         }
     }
 
@@ -124,6 +153,19 @@ impl<'a> Refiner<'a> {
                 verts,
             })
         };
+        if verts.iter().any(|&v| self.dom.near_acute(v)) {
+            // Next to a small input angle only size is enforced, and by the longest edge: the
+            // tets there may stay flat, and a flat tet's circumradius says nothing about its size.
+            let centroid = (a + b + c + d) * 0.25;
+            let xi =
+                longest_edge(a, b, c, d) / (EDGE_PER_RADIUS * self.spacing_at(centroid, tag)?);
+            return Ok((xi > self.params.size_factor).then_some(Bad {
+                class: SIZE,
+                badness: xi,
+                tet: t,
+                verts,
+            }));
+        }
         let Some(centre) = s.circumcenter else {
             return Ok(bad(SLIVER, f64::INFINITY));
         };
@@ -203,13 +245,35 @@ impl<'a> Refiner<'a> {
             return Ok(());
         }
         let [a, b, c, d] = self.dom.dt.tet_points(bad.tet);
+        if bad.verts.iter().any(|&v| self.dom.near_acute(v)) {
+            // Size-bad next to a small angle (see `classify`): split at the centroid, which
+            // lies in the tet even when it is flat and its circumcentre is far away.
+            let centroid = (a + b + c + d) * 0.25;
+            return self.insert_volume_point(centroid, 0.5 * longest_edge(a, b, c, d), bad.tet);
+        }
         let q = Shape::of(a, b, c, d);
         let Some(centre) = q.circumcenter else {
             self.gave_up += 1;
             return Ok(());
         };
         let r = q.circumradius;
+        if !self.domain_box.contains(centre) {
+            // A nearly flat tet next to the boundary (four almost cocircular points): its
+            // circumcentre is outside the domain, possibly very far; it would encroach only
+            // boundary elements far smaller than r (the cascade the guard below refuses), and
+            // locating it costs a long walk through exact predicates. Only restoring the
+            // boundary around it can help.
+            if !self.resettle_near(bad.tet)? {
+                self.gave_up += 1;
+            }
+            return Ok(());
+        }
         if let Some(bnd) = self.encroached_boundary(centre, Some(bad.tet)) {
+            if self.is_protected(bnd) {
+                self.gave_up += 1;
+                self.blocked_by_small_angle.insert(sorted4(bad.verts));
+                return Ok(());
+            }
             let rb = self.boundary_radius(bnd);
             // Without small input angles an encroached boundary element has R >= R_tau / 2
             // (the paper, section 2.4); a much smaller one means splitting it would start a
@@ -248,6 +312,30 @@ impl<'a> Refiner<'a> {
         }
         self.dom
             .insert_point(p, super::domain::VertexKind::Volume, Some(bad.tet))?;
+        self.settle_boundary()?;
+        self.push_recent()
+    }
+
+    /// Inserts `p` (for bad tet `t` of size `r`) unless it would break the boundary; then the
+    /// boundary element is split instead if it is not much smaller than `r`, else nothing.
+    fn insert_volume_point(&mut self, p: DVec3, r: f64, t: u32) -> Result<(), MeshError> {
+        let DryRun::Cavity { removed, .. } = self.dom.dt.dry_run(p, Some(t)) else {
+            self.gave_up += 1; // p is a vertex already (a flat tet's centroid can be)
+            return Ok(());
+        };
+        if let Some(bnd) = self.boundary_in_cavity(p, &removed) {
+            if !self.is_protected(bnd) && self.boundary_radius(bnd) >= 0.25 * r {
+                return self.split_boundary(bnd, r);
+            }
+            if self.is_protected(bnd) {
+                self.blocked_by_small_angle
+                    .insert(sorted4(self.dom.dt.tet(t)));
+            }
+            self.gave_up += 1;
+            return Ok(());
+        }
+        self.dom
+            .insert_point(p, super::domain::VertexKind::Volume, Some(t))?;
         self.settle_boundary()?;
         self.push_recent()
     }
@@ -419,6 +507,15 @@ impl<'a> Refiner<'a> {
         Ok(self.dom.dt.num_vertices() > n_before)
     }
 
+    /// Whether refinement must not split boundary element `b`: it touches a small input
+    /// angle (`Domain::near_acute_element`).
+    fn is_protected(&self, b: Boundary) -> bool {
+        match b {
+            Boundary::Segment(a, c) => self.dom.near_acute_element(&[a, c]),
+            Boundary::Facet(_, t) => self.dom.near_acute_element(&t),
+        }
+    }
+
     fn boundary_radius(&self, b: Boundary) -> f64 {
         match b {
             Boundary::Segment(a, b) => 0.5 * self.dom.point(a).distance(self.dom.point(b)),
@@ -524,6 +621,30 @@ impl<'a> Refiner<'a> {
         let mut budget = super::recover::MAX_RECOVERY_SPLITS;
         self.dom.settle(&mut budget)
     }
+}
+
+/// Longest edge over circumradius of a regular tet (sqrt(8/3)): the size measure next to small
+/// angles compares the longest edge with this many times f.
+const EDGE_PER_RADIUS: f64 = 1.632_993_161_855_452;
+
+/// A tet's vertex ids in increasing order (a key independent of orientation).
+pub fn sorted4(mut t: [u32; 4]) -> [u32; 4] {
+    t.sort_unstable();
+    t
+}
+
+fn longest_edge(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
+    [
+        a.distance_squared(b),
+        a.distance_squared(c),
+        a.distance_squared(d),
+        b.distance_squared(c),
+        b.distance_squared(d),
+        c.distance_squared(d),
+    ]
+    .into_iter()
+    .fold(0.0, f64::max)
+    .sqrt()
 }
 
 /// The measures refinement decides on, computed without trigonometry.

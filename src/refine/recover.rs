@@ -210,19 +210,24 @@ impl Domain {
             }
             return Ok(());
         }
-        if self.facets[f as usize].locate(centre).is_none() {
-            // Outside the facet yet encroaching none of its subsegments: only possible through
-            // rounding; split the longest edge of the subfacet's own subsegments, else insert
-            // the centroid.
-            let centroid = (a + b + c) / 3.0;
+        // The centre may still be refused: beyond a subsegment that it does not encroach
+        // (possible when a protected subsegment is left encroached), split that subsegment
+        // instead; on a vertex of the facet (a cocircular neighbour) or outside through
+        // rounding, the subfacet's centroid splits it.
+        let fm = &self.facets[f as usize];
+        let p = if fm.locate(centre).is_some() && fm.can_insert(centre).is_ok() {
+            centre
+        } else if let Some([x, y]) = fm.constrained_edge_towards(tri, centre) {
             spend(budget)?;
-            let hint = self.dt.vertex_tet(tri[0]);
-            self.split_in_facet(f, centroid, hint)?;
+            let p = self.segment_split_point(x, y);
+            self.split_subsegment(x, y, p)?;
             return Ok(());
-        }
+        } else {
+            (a + b + c) / 3.0
+        };
         spend(budget)?;
         let hint = self.dt.vertex_tet(tri[0]);
-        self.split_in_facet(f, centre, hint)?;
+        self.split_in_facet(f, p, hint)?;
         Ok(())
     }
 

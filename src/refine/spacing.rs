@@ -8,6 +8,8 @@ use glam::DVec3;
 
 /// Grading: how fast the automatic spacing may grow away from the boundary.
 const ALPHA: f64 = 0.35;
+/// Boundary sizes below this many times ALPHA x cell are kept as points (exact near them).
+const SMALL_CELLS: f64 = 2.0;
 /// Grid cells along the longest side of the bounding box.
 const CELLS: usize = 40;
 
@@ -15,23 +17,17 @@ pub struct AutoSpacing {
     lo: DVec3,
     cell: f64,
     dims: [usize; 3],
+    /// f at each cell centre (up to the chamfer propagation's approximation).
     value: Vec<f64>,
+    /// Per cell: boundary vertices whose h is small next to the cell size, (point, h), so that
+    /// f near them is exact instead of smeared over whole cells (a cluster of tiny edges at an
+    /// acute corner must not make a whole cell fine).
+    small: Vec<Vec<(DVec3, f64)>>,
 }
 
 impl AutoSpacing {
     pub(crate) fn from_boundary(dom: &Domain) -> AutoSpacing {
         let pts = dom.dt.points();
-        let (mut lo, mut hi) = (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN));
-        for &p in pts {
-            lo = lo.min(p);
-            hi = hi.max(p);
-        }
-        let ext = (hi - lo).max_element().max(1e-300);
-        let cell = ext / CELLS as f64;
-        let dims = ((hi - lo) / cell)
-            .as_uvec3()
-            .to_array()
-            .map(|d| d as usize + 1);
         let mut h = vec![f64::INFINITY; pts.len()];
         for t in dom.subfacets.keys() {
             for k in 0..3 {
@@ -41,20 +37,58 @@ impl AutoSpacing {
                 h[b as usize] = h[b as usize].min(l);
             }
         }
+        let sized: Vec<(DVec3, f64)> = pts
+            .iter()
+            .zip(&h)
+            .filter(|(_, hv)| hv.is_finite())
+            .map(|(&p, &hv)| (p, hv))
+            .collect();
+        AutoSpacing::from_sizes(&sized)
+    }
+
+    /// The Lipschitz extension of sizes h_v given at points v.
+    pub(crate) fn from_sizes(sized: &[(DVec3, f64)]) -> AutoSpacing {
+        let (mut lo, mut hi) = (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN));
+        for &(p, _) in sized {
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+        if sized.is_empty() {
+            (lo, hi) = (DVec3::ZERO, DVec3::ONE);
+        }
+        let ext = (hi - lo).max_element().max(1e-300);
+        let cell = ext / CELLS as f64;
+        let dims = ((hi - lo) / cell)
+            .as_uvec3()
+            .to_array()
+            .map(|d| d as usize + 1);
+        let n = dims[0] * dims[1] * dims[2];
         let mut s = AutoSpacing {
             lo,
             cell,
             dims,
-            value: vec![ext / 4.0; dims[0] * dims[1] * dims[2]],
+            value: vec![ext / 4.0; n],
+            small: vec![vec![]; n],
         };
-        for (v, &hv) in h.iter().enumerate() {
-            if hv.is_finite() {
-                let i = s.index(pts[v]);
-                s.value[i] = s.value[i].min(hv);
+        for &(p, hv) in sized {
+            let i = s.index(p);
+            let at_centre = hv + ALPHA * p.distance(s.centre(i));
+            s.value[i] = s.value[i].min(at_centre);
+            if hv < SMALL_CELLS * ALPHA * cell {
+                s.small[i].push((p, hv));
             }
+        }
+        for list in &mut s.small {
+            prune_dominated(list);
         }
         s.propagate();
         s
+    }
+
+    fn centre(&self, i: usize) -> DVec3 {
+        let [nx, ny, _] = self.dims;
+        let (ii, jj, kk) = (i % nx, (i / nx) % ny, i / (nx * ny));
+        self.lo + DVec3::new(ii as f64 + 0.5, jj as f64 + 0.5, kk as f64 + 0.5) * self.cell
     }
 
     fn index(&self, p: DVec3) -> usize {
@@ -113,9 +147,81 @@ impl AutoSpacing {
     }
 }
 
+/// Drops the entries another one dominates (h_u + ALPHA |u - v| <= h_v): they never give the
+/// minimum.
+fn prune_dominated(list: &mut Vec<(DVec3, f64)>) {
+    list.sort_by(|a, b| a.1.total_cmp(&b.1));
+    let mut kept: Vec<(DVec3, f64)> = Vec::with_capacity(list.len());
+    for &(p, hv) in list.iter() {
+        if !kept.iter().any(|&(q, hq)| hq + ALPHA * q.distance(p) <= hv) {
+            kept.push((p, hv));
+        }
+    }
+    *list = kept;
+}
+
 impl Spacing for AutoSpacing {
     fn at(&self, p: DVec3) -> f64 {
-        // The cell value plus the grading over at most one cell diagonal keeps f Lipschitz.
-        self.value[self.index(p)]
+        // Far sizes through the cell centre's value (Lipschitz from the centre), near small
+        // ones exactly from the cell and its 26 neighbours: a small size further away than a
+        // cell is already within its grading in the centre values.
+        let i = self.index(p);
+        let mut f = self.value[i] + ALPHA * p.distance(self.centre(i));
+        let [nx, ny, nz] = self.dims;
+        let (ii, jj, kk) = (i % nx, (i / nx) % ny, i / (nx * ny));
+        for k in kk.saturating_sub(1)..(kk + 2).min(nz) {
+            for j in jj.saturating_sub(1)..(jj + 2).min(ny) {
+                for c in ii.saturating_sub(1)..(ii + 2).min(nx) {
+                    for &(q, hq) in &self.small[(k * ny + j) * nx + c] {
+                        f = f.min(hq + ALPHA * q.distance(p));
+                    }
+                }
+            }
+        }
+        f
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+
+    fn exact(sized: &[(DVec3, f64)], p: DVec3) -> f64 {
+        sized
+            .iter()
+            .map(|&(q, h)| h + ALPHA * q.distance(p))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    #[test]
+    fn close_to_the_exact_lipschitz_extension() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let mut sized: Vec<(DVec3, f64)> = (0..400)
+            .map(|_| {
+                let p = DVec3::new(rng.gen(), rng.gen(), rng.gen());
+                (p, rng.gen_range(0.01..0.1))
+            })
+            .collect();
+        // A cluster of tiny sizes, as at an acute corner after recovery.
+        let corner = DVec3::new(0.3, 0.6, 0.2);
+        for k in 0..30 {
+            let r = 0.5f64.powi(k / 3 + 3);
+            sized.push((corner + DVec3::new(r, 0.0, 0.0), r * 0.3));
+        }
+        let s = AutoSpacing::from_sizes(&sized);
+        for _ in 0..2000 {
+            let p = DVec3::new(rng.gen(), rng.gen(), rng.gen());
+            let (f, e) = (s.at(p), exact(&sized, p));
+            assert!(
+                f >= e * (1.0 - 1e-12) && f <= 3.0 * e,
+                "{p}: {f} vs exact {e}"
+            );
+        }
+        // Next to the corner the tiny sizes count exactly; half a cell away they have graded.
+        let near = corner + DVec3::new(1e-4, 0.0, 0.0);
+        assert!((s.at(near) - exact(&sized, near)).abs() < 1e-12);
+        let away = corner + DVec3::new(0.0, 0.5 / CELLS as f64, 0.0);
+        assert!(s.at(away) > 10.0 * exact(&sized, near));
     }
 }
