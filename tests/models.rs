@@ -57,7 +57,6 @@ fn off_models_conform() {
 
 #[test]
 fn acute_off_models_conform() {
-    // part.off still fails (a facet edge split refused: WouldInvert); see the issue note.
     for rel in [
         "off/star.off",
         "off/joint.off",
@@ -72,7 +71,6 @@ fn acute_off_models_conform() {
 }
 
 #[test]
-#[ignore = "slow in debug builds; run with --release"]
 fn big_acute_off_models_conform() {
     for rel in ["off/elephant.off", "off/fandisk.off"] {
         conforming(rel, None);

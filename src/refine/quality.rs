@@ -257,9 +257,12 @@ impl<'a> Refiner<'a> {
             return Ok(());
         };
         let r = q.circumradius;
-        if !self.domain_box.contains(centre) {
+        let centroid = (a + b + c + d) * 0.25;
+        if !self.domain_box.contains(centre)
+            && centre.distance(centroid) > FAR_CENTRE_PER_EDGE * longest_edge(a, b, c, d)
+        {
             // A nearly flat tet next to the boundary (four almost cocircular points): its
-            // circumcentre is outside the domain, possibly very far; it would encroach only
+            // circumcentre is outside the domain and far away; it would encroach only
             // boundary elements far smaller than r (the cascade the guard below refuses), and
             // locating it costs a long walk through exact predicates. Only restoring the
             // boundary around it can help.
@@ -280,6 +283,13 @@ impl<'a> Refiner<'a> {
             // cascade of ever smaller splits (an acute angle nearby).
             if rb < 0.25 * r && !self.resettle_near(bad.tet)? {
                 self.gave_up += 1;
+                if self
+                    .boundary_vertices(bnd)
+                    .iter()
+                    .any(|&v| v != u32::MAX && self.dom.influenced_by_acute_angle(v))
+                {
+                    self.blocked_by_small_angle.insert(sorted4(bad.verts));
+                }
                 return Ok(());
             }
             return self.split_boundary(bnd, r);
@@ -516,6 +526,14 @@ impl<'a> Refiner<'a> {
         }
     }
 
+    /// The vertices of boundary element `b` (a subsegment's third entry is `u32::MAX`).
+    fn boundary_vertices(&self, b: Boundary) -> [u32; 3] {
+        match b {
+            Boundary::Segment(a, c) => [a, c, u32::MAX],
+            Boundary::Facet(_, t) => t,
+        }
+    }
+
     fn boundary_radius(&self, b: Boundary) -> f64 {
         match b {
             Boundary::Segment(a, b) => 0.5 * self.dom.point(a).distance(self.dom.point(b)),
@@ -622,6 +640,10 @@ impl<'a> Refiner<'a> {
         self.dom.settle(&mut budget)
     }
 }
+
+/// A circumcentre outside the domain's box and further than this many longest edges from
+/// its tet is not located (see `refine_tet`).
+const FAR_CENTRE_PER_EDGE: f64 = 100.0;
 
 /// Longest edge over circumradius of a regular tet (sqrt(8/3)): the size measure next to small
 /// angles compares the longest edge with this many times f.

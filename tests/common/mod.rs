@@ -167,8 +167,30 @@ pub fn check_conforming(rel: &str, input: &PlcInput, m: &TetMesh, volume: Option
         );
     }
     assert_eq!(want.len(), got.len(), "{rel}: markers");
-    if let Some(v) = volume {
+    if let Some(v) = volume.or_else(|| enclosed_volume(input)) {
         let vol = total_volume(m);
         assert!(rel_close(vol, v, 1e-9), "{rel}: volume {vol}, expected {v}");
     }
+}
+
+/// The volume a closed, consistently oriented surface of simple polygons encloses (divergence
+/// theorem over fan triangles), or None when the input has holes or internal facets' regions.
+pub fn enclosed_volume(input: &PlcInput) -> Option<f64> {
+    if !input.holes.is_empty() || !input.regions.is_empty() {
+        return None;
+    }
+    let mut six_v = 0.0;
+    for f in &input.facets {
+        if !f.hole_polygons.is_empty() || f.polygons.len() != 1 {
+            return None;
+        }
+        let p: Vec<DVec3> = f.polygons[0]
+            .iter()
+            .map(|&i| input.vertices[i as usize])
+            .collect();
+        for k in 1..p.len().saturating_sub(1) {
+            six_v += p[0].dot(p[k].cross(p[k + 1]));
+        }
+    }
+    Some(six_v.abs() / 6.0)
 }
