@@ -8,8 +8,8 @@
 use super::domain::{seg_key, tri_key, Domain, VertexKind};
 use super::mark::Regions;
 use super::{MeshError, Params, Spacing};
-use crate::delaunay::{tables::FACE, DryRun, INFINITE};
-use crate::geom::{diametric_ball, equatorial_ball, tri_circumcenter};
+use crate::delaunay::{tables::FACE, Probe, INFINITE};
+use crate::geom::{circumsphere, diametric_ball, equatorial_ball, tri_circumcenter};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -113,9 +113,8 @@ impl<'a> Refiner<'a> {
         if tag == 0 || !self.dom.dt.is_finite(t) {
             return Ok(None);
         }
-        let [a, b, c, d] = self.dom.dt.tet_points(t);
-        let s = Shape::of(a, b, c, d);
         let verts = self.dom.dt.tet(t);
+        let [a, b, c, d] = verts.map(|v| self.dom.point(v));
         let bad = |class, badness| {
             Some(Bad {
                 class,
@@ -124,17 +123,22 @@ impl<'a> Refiner<'a> {
                 verts,
             })
         };
-        let Some(centre) = s.circumcenter else {
+        // Shape::of's measures, each computed only when the tests before it pass.
+        let Some((centre, circumradius)) = circumsphere(a, b, c, d) else {
             return Ok(bad(SLIVER, f64::INFINITY));
         };
-        let xi = s.circumradius / self.spacing_at(centre, tag)?;
-        let rho = s.circumradius / s.shortest_edge;
-        Ok(if xi > self.params.size_factor {
-            bad(SIZE, xi)
-        } else if rho > self.params.rho0 {
-            bad(RATIO, rho)
-        } else if self.is_sliver(&s) {
-            bad(SLIVER, s.max_cos_dihedral)
+        let xi = circumradius / self.spacing_at(centre, tag)?;
+        if xi > self.params.size_factor {
+            return Ok(bad(SIZE, xi));
+        }
+        let l2 = shortest_edge_sq(a, b, c, d);
+        let rho = circumradius / l2.sqrt();
+        if rho > self.params.rho0 {
+            return Ok(bad(RATIO, rho));
+        }
+        let (sigma, max_cos_dihedral) = sliver_measures(a, b, c, d, l2);
+        Ok(if self.is_sliver_by(sigma, max_cos_dihedral) {
+            bad(SLIVER, max_cos_dihedral)
         } else {
             None
         })
@@ -220,32 +224,20 @@ impl<'a> Refiner<'a> {
             }
             return self.split_boundary(bnd, r);
         }
-        // Draw candidates from the picking ball; keep the one with fewest small slivers.
-        let mut best: Option<(usize, f64, DVec3)> = None;
+        // Draw candidates from the picking ball; keep the one with fewest small slivers among
+        // those that break no boundary.
+        let mut best = None;
         for _ in 0..self.params.max_tries.max(1) {
             let p = centre + self.random_in_ball() * (self.params.delta * r);
-            let Some((n_small, worst)) = self.small_slivers(p, r, Some(bad.tet), None) else {
-                continue; // p would break the boundary
-            };
-            if best.is_none_or(|(n, w, _)| (n_small, -worst) < (n, -w)) {
-                best = Some((n_small, worst, p));
-            }
-            if n_small == 0 {
+            if self.try_candidate(p, r, Some(bad.tet), None, &mut best) {
                 break;
             }
         }
-        let p = match best {
-            Some((_, _, p)) => p,
-            None => centre,
-        };
-        if self.encroached_boundary(p, Some(bad.tet)).is_some() {
-            // Every draw would break the boundary and so does the centre (only near it).
-            if let Some(bnd) = self.encroached_boundary(centre, Some(bad.tet)) {
-                return self.split_boundary(bnd, r);
-            }
-            self.gave_up += 1;
-            return Ok(());
-        }
+        // The chosen point breaks no boundary: a candidate was only kept after that check on
+        // its cavity, and the centre passed it above (nothing has changed since). When it was
+        // the last one probed (the usual case: its draw ended the search), the insertion
+        // reuses its cavity.
+        let p = best.map_or(centre, |b| b.p);
         self.dom
             .insert_point(p, super::domain::VertexKind::Volume, Some(bad.tet))?;
         self.settle_boundary()?;
@@ -265,40 +257,62 @@ impl<'a> Refiner<'a> {
         }
     }
 
-    /// Small slivers (circumradius <= b R, sigma < sigma0) inserting `p` would create, and the
-    /// smallest sigma among them; None if inserting `p` would cross the boundary (unless the
-    /// boundary element is `allowed`, the one being split).
-    fn small_slivers(
+    /// Probes candidate `p` for a bad element of circumradius `r` and makes it `best` if it
+    /// creates fewer small slivers (circumradius <= b r, sigma < sigma0 or a small dihedral
+    /// angle; ties: the larger smallest dihedral angle) and breaks no boundary (except the
+    /// element being split, `allowed`). Returns true when `p` creates no small sliver (the
+    /// search can stop; `p` is then the last point probed).
+    fn try_candidate(
         &mut self,
         p: DVec3,
         r: f64,
         hint: Option<u32>,
         allowed: Option<Boundary>,
-    ) -> Option<(usize, f64)> {
-        let DryRun::Cavity { removed, faces } = self.dom.dt.dry_run(p, hint) else {
-            return None;
-        };
-        if allowed.is_none() && self.boundary_in_cavity(p, &removed).is_some() {
-            return None;
+        best: &mut Option<Candidate>,
+    ) -> bool {
+        if let Probe::Duplicate(_) = self.dom.dt.probe(p, hint) {
+            return false;
         }
-        let mut n = 0;
-        let mut worst = f64::INFINITY;
-        for f in faces {
-            if f.contains(&INFINITE) {
-                continue;
-            }
-            let [x, y, z] = f.map(|v| self.dom.point(v));
-            let s = Shape::of(x, y, z, p);
-            if s.circumradius <= self.params.b * r && self.is_sliver(&s) {
-                n += 1;
-                worst = worst.min(s.max_cos_dihedral.mul_add(-1.0, 1.0));
-            }
+        let (n_small, worst) = self.small_slivers(p, r);
+        if best.is_some_and(|b| (n_small, -worst) >= (b.n_small, -b.worst)) {
+            return false; // not better: whether it breaks the boundary does not matter
         }
-        Some((n, worst))
+        if allowed.is_none() && self.boundary_in_cavity(p).is_some() {
+            return false; // p would break the boundary
+        }
+        *best = Some(Candidate { n_small, worst, p });
+        n_small == 0
     }
 
-    fn is_sliver(&self, s: &Shape) -> bool {
-        s.sigma < self.params.sigma0 || s.max_cos_dihedral > self.cos_min_dihedral
+    /// Small slivers (circumradius <= b R, sigma < sigma0 or a small dihedral angle) inserting
+    /// `p` would create, with the probed cavity of `p`, and the smallest 1 - cos(smallest
+    /// dihedral angle) among them.
+    fn small_slivers(&self, p: DVec3, r: f64) -> (usize, f64) {
+        let mut n = 0;
+        let mut worst = f64::INFINITY;
+        let max_r = self.params.b * r;
+        for f in self.dom.dt.probed_cavity().1 {
+            let [x, y, z] = f.vertices();
+            if z == INFINITE || x == INFINITE || y == INFINITE {
+                continue;
+            }
+            let [x, y, z] = [x, y, z].map(|v| self.dom.point(v));
+            // The sliver test first: most new tets pass it, and then their circumradius is
+            // not needed.
+            let (sigma, max_cos) = sliver_measures(x, y, z, p, shortest_edge_sq(x, y, z, p));
+            if self.is_sliver_by(sigma, max_cos)
+                && circumsphere(x, y, z, p).map_or(f64::INFINITY, |s| s.1) <= max_r
+            {
+                n += 1;
+                worst = worst.min(max_cos.mul_add(-1.0, 1.0));
+            }
+        }
+        (n, worst)
+    }
+
+    #[inline]
+    fn is_sliver_by(&self, sigma: f64, max_cos_dihedral: f64) -> bool {
+        sigma < self.params.sigma0 || max_cos_dihedral > self.cos_min_dihedral
     }
 
     /// The boundary element whose protection inserting `p` would violate: a subsegment or
@@ -306,85 +320,53 @@ impl<'a> Refiner<'a> {
     /// ball, or, when the cavity would cross the boundary (it holds an outside tet or would
     /// delete a subfacet), the subfacet it crosses.
     fn encroached_boundary(&mut self, p: DVec3, hint: Option<u32>) -> Option<Boundary> {
-        let DryRun::Cavity { removed, .. } = self.dom.dt.dry_run(p, hint) else {
+        if let Probe::Duplicate(_) = self.dom.dt.probe(p, hint) {
             return None;
-        };
-        self.boundary_in_cavity(p, &removed)
+        }
+        self.boundary_in_cavity(p)
     }
 
-    /// See [`Self::encroached_boundary`]; `removed` is the cavity of `p`.
-    fn boundary_in_cavity(&self, p: DVec3, removed: &[u32]) -> Option<Boundary> {
+    /// See [`Self::encroached_boundary`], for the probed cavity of `p`. Looks at the cavity
+    /// and the ring of tets around it (an equatorial ball can hold p while the (obtuse) tet on
+    /// its inner side does not have p in its circumsphere); of the encroached elements it
+    /// names the smallest subsegment (by key), else the smallest subfacet.
+    fn boundary_in_cavity(&self, p: DVec3) -> Option<Boundary> {
         let dom = &*self.dom;
+        let (removed, faces) = dom.dt.probed_cavity();
+        let mut scan = BoundaryScan {
+            p,
+            removed,
+            seg: None,
+            facet: None,
+            any_facet: None,
+            crossed: None,
+        };
         let mut crosses = false;
-        let mut crossed: Option<Boundary> = None;
-        let mut segs = vec![];
-        let mut facets = vec![];
-        // The cavity and the ring of tets around it: an equatorial ball can hold p while the
-        // (obtuse) tet on its inner side does not have p in its circumsphere.
-        let mut sorted = removed.to_vec();
-        sorted.sort_unstable();
-        let in_removed = |t: u32| sorted.binary_search(&t).is_ok();
-        // (Ring tets may repeat: harmless, the checks below are idempotent.)
-        let mut near: Vec<u32> = removed.to_vec();
         for &t in removed {
-            for n in dom.dt.neighbors(t) {
-                if !in_removed(n) {
-                    near.push(n);
-                }
-            }
-        }
-        for (k, &t) in near.iter().enumerate() {
-            let in_cavity = k < removed.len();
             if !dom.dt.is_finite(t) || dom.dt.tag(t) == 0 {
-                crosses |= in_cavity;
+                crosses = true;
                 continue;
             }
-            let v = dom.dt.tet(t);
-            let on_boundary = v.map(|x| dom.kind[x as usize] != VertexKind::Volume);
-            if on_boundary.iter().filter(|&&b| b).count() < 2 {
-                continue; // no subsegment or subfacet among its edges and faces
-            }
-            for i in 0..4 {
-                for j in i + 1..4 {
-                    let k = seg_key(v[i], v[j]);
-                    if on_boundary[i] && on_boundary[j] && dom.subsegs.contains_key(&k) {
-                        segs.push(k);
-                    }
-                }
-                if on_boundary[i] {
-                    continue; // face i is opposite vertex i: it holds the other three
-                }
-                let f = FACE[i].map(|l| v[l]);
-                if let Some(&fi) = dom.subfacets.get(&tri_key(f)) {
-                    facets.push((fi, tri_key(f)));
-                    let n = dom.dt.neighbors(t)[i];
-                    if in_cavity && in_removed(n) {
-                        crosses = true;
-                        crossed = Some(Boundary::Facet(fi, tri_key(f)));
-                    }
-                }
+            scan.tet(dom, t, true);
+        }
+        // The ring: the tets across the cavity's boundary faces (a tet may come up more than
+        // once; the checks are idempotent).
+        for f in faces {
+            let t = f.outer_tet();
+            if dom.dt.is_finite(t) && dom.dt.tag(t) != 0 {
+                scan.tet(dom, t, false);
             }
         }
-        segs.sort_unstable();
-        segs.dedup();
-        for &(a, b) in &segs {
-            let (c, r) = diametric_ball(dom.point(a), dom.point(b));
-            if p.distance_squared(c) <= r * r {
-                return Some(Boundary::Segment(a, b));
-            }
+        if let Some((a, b)) = scan.seg {
+            return Some(Boundary::Segment(a, b));
         }
-        facets.sort_unstable();
-        facets.dedup();
-        for &(fi, t) in &facets {
-            let [x, y, z] = t.map(|v| dom.point(v));
-            if let Some((c, r)) = equatorial_ball(x, y, z) {
-                if p.distance_squared(c) <= r * r {
-                    return Some(Boundary::Facet(fi, t));
-                }
-            }
+        if let Some((fi, t)) = scan.facet {
+            return Some(Boundary::Facet(fi, t));
         }
-        if crosses {
-            return crossed.or_else(|| facets.first().map(|&(fi, t)| Boundary::Facet(fi, t)));
+        if crosses || scan.crossed.is_some() {
+            return scan
+                .crossed
+                .or_else(|| scan.any_facet.map(|(fi, t)| Boundary::Facet(fi, t)));
         }
         None
     }
@@ -452,7 +434,7 @@ impl<'a> Refiner<'a> {
                     let n = (y - x).cross(z - x).normalize();
                     let u = (y - x).normalize();
                     let w = n.cross(u);
-                    let mut best: Option<(usize, f64, DVec3)> = None;
+                    let mut best = None;
                     for _ in 0..self.params.max_tries.max(1) {
                         let (s, th) = (
                             self.rng.gen::<f64>().sqrt(),
@@ -466,18 +448,11 @@ impl<'a> Refiner<'a> {
                             continue;
                         }
                         let hint = self.dom.dt.vertex_tet(t[0]);
-                        let Some((n_small, worst)) = self.small_slivers(p, rf, hint, Some(b))
-                        else {
-                            continue;
-                        };
-                        if best.is_none_or(|(n, w, _)| (n_small, -worst) < (n, -w)) {
-                            best = Some((n_small, worst, p));
-                        }
-                        if n_small == 0 {
+                        if self.try_candidate(p, rf, hint, Some(b), &mut best) {
                             break;
                         }
                     }
-                    let p = best.map_or(cf, |(_, _, p)| p);
+                    let p = best.map_or(cf, |c| c.p);
                     let hint = self.dom.dt.vertex_tet(t[0]);
                     self.dom.split_in_facet(f, p, hint)?;
                 }
@@ -496,24 +471,17 @@ impl<'a> Refiner<'a> {
             self.dom.segment_split_point(a, c)
         } else {
             let r = 0.5 * pa.distance(pc);
-            let mut best: Option<(usize, f64, DVec3)> = None;
+            let mut best = None;
             for _ in 0..self.params.max_tries.max(1) {
                 let t = 0.5 + self.rng.gen_range(-0.5..0.5) * self.params.delta;
                 let p = pa + (pc - pa) * t;
                 let hint = self.dom.dt.vertex_tet(a);
-                let Some((n_small, worst)) =
-                    self.small_slivers(p, r, hint, Some(Boundary::Segment(a, c)))
-                else {
-                    continue;
-                };
-                if best.is_none_or(|(n, w, _)| (n_small, -worst) < (n, -w)) {
-                    best = Some((n_small, worst, p));
-                }
-                if n_small == 0 {
+                let allowed = Some(Boundary::Segment(a, c));
+                if self.try_candidate(p, r, hint, allowed, &mut best) {
                     break;
                 }
             }
-            best.map_or(pa + (pc - pa) * 0.5, |(_, _, p)| p)
+            best.map_or(pa + (pc - pa) * 0.5, |c| c.p)
         };
         self.dom.split_subsegment(a, c, p)?;
         Ok(())
@@ -526,8 +494,10 @@ impl<'a> Refiner<'a> {
     }
 }
 
-/// The measures refinement decides on, computed without trigonometry.
+/// The measures refinement decides on, computed without trigonometry (the refiner computes
+/// them piecemeal, with the same expressions; all of them are checked by a test).
 #[derive(Debug, Clone, Copy)]
+#[cfg_attr(not(test), allow(dead_code))]
 struct Shape {
     circumcenter: Option<DVec3>,
     circumradius: f64,
@@ -540,42 +510,131 @@ struct Shape {
 impl Shape {
     #[inline]
     fn of(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Shape {
-        let sphere = crate::geom::circumsphere(a, b, c, d);
-        let l2 = [
-            a.distance_squared(b),
-            a.distance_squared(c),
-            a.distance_squared(d),
-            b.distance_squared(c),
-            b.distance_squared(d),
-            c.distance_squared(d),
-        ]
-        .into_iter()
-        .fold(f64::INFINITY, f64::min);
-        let shortest_edge = l2.sqrt();
-        let volume = (b - a).dot((c - a).cross(d - a)).abs() / 6.0;
-        // Face normals, all outward or all inward (the sign cancels): the dihedral angle at an
-        // edge is pi minus the angle between its two faces' normals, so its cosine is
-        // -n_i . n_j / (|n_i| |n_j|).
-        let n = [
-            (d - b).cross(c - b),
-            (c - a).cross(d - a),
-            (d - a).cross(b - a),
-            (b - a).cross(c - a),
-        ];
-        let len = n.map(|v| v.length());
-        let mut max_cos = -1.0f64;
-        for i in 0..4 {
-            for j in i + 1..4 {
-                let cos = -n[i].dot(n[j]) / (len[i] * len[j]);
-                max_cos = max_cos.max(cos);
-            }
-        }
+        let sphere = circumsphere(a, b, c, d);
+        let l2 = shortest_edge_sq(a, b, c, d);
+        let (sigma, max_cos_dihedral) = sliver_measures(a, b, c, d, l2);
         Shape {
             circumcenter: sphere.map(|s| s.0),
             circumradius: sphere.map_or(f64::INFINITY, |s| s.1),
-            shortest_edge,
-            sigma: volume / (l2 * shortest_edge),
-            max_cos_dihedral: if max_cos.is_nan() { 1.0 } else { max_cos },
+            shortest_edge: l2.sqrt(),
+            sigma,
+            max_cos_dihedral,
+        }
+    }
+}
+
+/// Squared length of the shortest edge.
+#[inline]
+fn shortest_edge_sq(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
+    [
+        a.distance_squared(b),
+        a.distance_squared(c),
+        a.distance_squared(d),
+        b.distance_squared(c),
+        b.distance_squared(d),
+        c.distance_squared(d),
+    ]
+    .into_iter()
+    .fold(f64::INFINITY, f64::min)
+}
+
+/// sigma = V / L^3 and the cosine of the smallest dihedral angle, given L^2 = `l2`.
+#[inline]
+fn sliver_measures(a: DVec3, b: DVec3, c: DVec3, d: DVec3, l2: f64) -> (f64, f64) {
+    let volume = (b - a).dot((c - a).cross(d - a)).abs() / 6.0;
+    // Face normals, all outward or all inward (the sign cancels): the dihedral angle at an
+    // edge is pi minus the angle between its two faces' normals, so its cosine is
+    // -n_i . n_j / (|n_i| |n_j|).
+    let n = [
+        (d - b).cross(c - b),
+        (c - a).cross(d - a),
+        (d - a).cross(b - a),
+        (b - a).cross(c - a),
+    ];
+    let len = n.map(|v| v.length());
+    let mut max_cos = -1.0f64;
+    for i in 0..4 {
+        for j in i + 1..4 {
+            let cos = -n[i].dot(n[j]) / (len[i] * len[j]);
+            max_cos = max_cos.max(cos);
+        }
+    }
+    let sigma = volume / (l2 * l2.sqrt());
+    (sigma, if max_cos.is_nan() { 1.0 } else { max_cos })
+}
+
+/// A candidate point and the small slivers inserting it would create.
+#[derive(Debug, Clone, Copy)]
+struct Candidate {
+    n_small: usize,
+    /// Smallest 1 - cos(smallest dihedral angle) among them.
+    worst: f64,
+    p: DVec3,
+}
+
+/// The boundary elements among a cavity's and its ring's edges and faces that a point
+/// encroaches or whose protection the cavity would break (see
+/// [`Refiner::boundary_in_cavity`]).
+struct BoundaryScan<'c> {
+    p: DVec3,
+    /// The cavity tets.
+    removed: &'c [u32],
+    /// Smallest encroached subsegment.
+    seg: Option<(u32, u32)>,
+    /// Smallest encroached subfacet.
+    facet: Option<(u32, [u32; 3])>,
+    /// Smallest subfacet seen.
+    any_facet: Option<(u32, [u32; 3])>,
+    /// The last subfacet seen with the cavity on both sides.
+    crossed: Option<Boundary>,
+}
+
+impl BoundaryScan<'_> {
+    /// The edges and faces of tet `t` (finite, inside the domain; `in_cavity` if it is a
+    /// cavity tet).
+    #[inline]
+    fn tet(&mut self, dom: &Domain, t: u32, in_cavity: bool) {
+        let v = dom.dt.tet(t);
+        let on_boundary = v.map(|x| dom.kind[x as usize] != VertexKind::Volume);
+        if on_boundary.iter().filter(|&&b| b).count() < 2 {
+            return; // no subsegment or subfacet among its edges and faces
+        }
+        for i in 0..4 {
+            for j in i + 1..4 {
+                if !(on_boundary[i] && on_boundary[j]) {
+                    continue;
+                }
+                let k = seg_key(v[i], v[j]);
+                if self.seg.is_some_and(|s| s <= k) || !dom.subsegs.contains_key(&k) {
+                    continue; // (a smaller one is encroached already)
+                }
+                let (c, r) = diametric_ball(dom.point(k.0), dom.point(k.1));
+                if self.p.distance_squared(c) <= r * r {
+                    self.seg = Some(k);
+                }
+            }
+            if on_boundary[i] {
+                continue; // face i is opposite vertex i: it holds the other three
+            }
+            let f = tri_key(FACE[i].map(|l| v[l]));
+            let Some(&fi) = dom.subfacets.get(&f) else {
+                continue;
+            };
+            let key = (fi, f);
+            if self.any_facet.is_none_or(|a| key < a) {
+                self.any_facet = Some(key);
+            }
+            if in_cavity && self.removed.contains(&dom.dt.neighbors(t)[i]) {
+                self.crossed = Some(Boundary::Facet(fi, f));
+            }
+            if self.seg.is_none() && self.facet.is_none_or(|e| key < e) {
+                let [x, y, z] = f.map(|v| dom.point(v));
+                if let Some((c, r)) = equatorial_ball(x, y, z) {
+                    if self.p.distance_squared(c) <= r * r {
+                        self.facet = Some(key);
+                    }
+                }
+            }
         }
     }
 }
