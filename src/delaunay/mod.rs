@@ -489,13 +489,17 @@ impl Delaunay {
         self.tets[(from >> 2) as usize].n[(from & 3) as usize] = to;
     }
 
-    /// Makes room for one more tet slot, growing the arrays by 1/8 (not Vec's doubling, which
-    /// would nearly double the peak memory when a big triangulation barely outgrows its
-    /// reservation).
+    /// Makes room for one more tet slot. Small arrays double (refinement grows a triangulation
+    /// from a few tets by single insertions: growing by small steps would copy it many times
+    /// over); from `GROW_BY_EIGHTHS` tets on they grow by 1/8 (doubling would nearly double the
+    /// peak memory when a big triangulation barely outgrows its reservation).
     #[inline]
     fn grow_tets(&mut self) {
+        /// 2^20 tets: 33 MiB of tet records and marks.
+        const GROW_BY_EIGHTHS: usize = 1 << 20;
         if self.tets.len() == self.tets.capacity() {
-            let extra = self.tets.len() / 8 + 1024;
+            let len = self.tets.len();
+            let extra = if len < GROW_BY_EIGHTHS { len } else { len / 8 } + 1024;
             self.tets.reserve_exact(extra);
             self.mark.reserve_exact(extra);
             if self.tags_enabled {

@@ -3,7 +3,7 @@
 //! seed. Each tet's kernel tag names its component (0 = outside), so tets created later
 //! inherit it.
 
-use super::domain::{tri_key, Domain};
+use super::domain::{tri_key, Domain, VertexKind};
 use super::MeshError;
 use crate::delaunay::{tables::FACE, INFINITE};
 use crate::plc::PlcInput;
@@ -16,19 +16,22 @@ pub struct Regions {
 }
 
 impl Domain {
-    /// Whether face `i` of tet `t` is a subfacet.
-    pub fn is_subfacet_face(&self, t: u32, i: usize) -> bool {
-        let v = self.dt.tet(t);
-        let f = FACE[i].map(|k| v[k]);
-        !f.contains(&INFINITE) && self.subfacets.contains_key(&tri_key(f))
-    }
-
     pub fn mark_domain(&mut self, input: &PlcInput) -> Result<Regions, MeshError> {
         let cap = self.dt.tet_capacity();
         let mut comp = vec![u32::MAX; cap];
         let mut outside = vec![];
         let mut n_comp = 0u32;
         let mut stack = vec![];
+        // Only a face whose three vertices lie on the boundary can be a subfacet: test that
+        // before the hash lookup (most faces have a volume vertex).
+        let on_boundary: Vec<bool> = self.kind.iter().map(|&k| k != VertexKind::Volume).collect();
+        let is_subfacet_face = |t: u32, i: usize| {
+            let v = self.dt.tet(t);
+            let f = FACE[i].map(|k| v[k]);
+            !f.contains(&INFINITE)
+                && f.iter().all(|&x| on_boundary[x as usize])
+                && self.subfacets.contains_key(&tri_key(f))
+        };
         for start in 0..cap as u32 {
             if !self.dt.is_alive(start) || comp[start as usize] != u32::MAX {
                 continue;
@@ -44,7 +47,7 @@ impl Domain {
                 }
                 let nb = self.dt.neighbors(t);
                 for (i, &n) in nb.iter().enumerate() {
-                    if comp[n as usize] == u32::MAX && !self.is_subfacet_face(t, i) {
+                    if comp[n as usize] == u32::MAX && !is_subfacet_face(t, i) {
                         comp[n as usize] = id;
                         stack.push(n);
                     }
