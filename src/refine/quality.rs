@@ -434,6 +434,11 @@ impl<'a> Refiner<'a> {
                     let n = (y - x).cross(z - x).normalize();
                     let u = (y - x).normalize();
                     let w = n.cross(u);
+                    // The facet's plane snap and subsegment balls, once for all the draws
+                    // (the same tests as snap_to_facet_plane and
+                    // facet_subsegments_encroached_by, which walk the whole facet).
+                    let snap = PlaneSnap::of(self.dom, f);
+                    let balls = subsegment_balls(self.dom, f);
                     let mut best = None;
                     for _ in 0..self.params.max_tries.max(1) {
                         let (s, th) = (
@@ -441,9 +446,9 @@ impl<'a> Refiner<'a> {
                             self.rng.gen::<f64>() * std::f64::consts::TAU,
                         );
                         let p = cf + (u * th.cos() + w * th.sin()) * (s * self.params.delta * rf);
-                        let p = self.dom.snap_to_facet_plane(f, p);
+                        let p = snap.apply(p);
                         if self.dom.facets[f as usize].locate(p).is_none()
-                            || !self.dom.facet_subsegments_encroached_by(f, p).is_empty()
+                            || balls.iter().any(|&(c, r2)| p.distance_squared(c) <= r2)
                         {
                             continue;
                         }
@@ -561,6 +566,52 @@ fn sliver_measures(a: DVec3, b: DVec3, c: DVec3, d: DVec3, l2: f64) -> (f64, f64
     }
     let sigma = volume / (l2 * l2.sqrt());
     (sigma, if max_cos.is_nan() { 1.0 } else { max_cos })
+}
+
+/// [`Domain::snap_to_facet_plane`] for one facet, its vertices looked at once: the
+/// coordinates shared by all of them.
+struct PlaneSnap([Option<f64>; 3]);
+
+impl PlaneSnap {
+    fn of(dom: &Domain, f: u32) -> PlaneSnap {
+        let mut verts = dom.facets[f as usize].vertices();
+        let mut axes = [None; 3];
+        if let Some(v0) = verts.next() {
+            let q0 = dom.point(v0);
+            axes = [Some(q0.x), Some(q0.y), Some(q0.z)];
+            for v in verts {
+                let q = dom.point(v);
+                for (axis, a) in axes.iter_mut().enumerate() {
+                    if a.is_some_and(|c| q[axis] != c) {
+                        *a = None;
+                    }
+                }
+            }
+        }
+        PlaneSnap(axes)
+    }
+
+    fn apply(&self, mut p: DVec3) -> DVec3 {
+        for (axis, a) in self.0.iter().enumerate() {
+            if let Some(c) = a {
+                p[axis] = *c;
+            }
+        }
+        p
+    }
+}
+
+/// The closed diametric balls of facet `f`'s subsegments, slightly inflated, as
+/// [`Domain::facet_subsegments_encroached_by`] tests them: (centre, squared radius).
+fn subsegment_balls(dom: &Domain, f: u32) -> Vec<(DVec3, f64)> {
+    dom.facets[f as usize]
+        .constrained_edges()
+        .into_iter()
+        .map(|[x, y]| {
+            let (c, r) = diametric_ball(dom.point(x), dom.point(y));
+            (c, r * r * (1.0 + 1e-9))
+        })
+        .collect()
 }
 
 /// A candidate point and the small slivers inserting it would create.
