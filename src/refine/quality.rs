@@ -333,6 +333,17 @@ impl<'a> Refiner<'a> {
     fn boundary_in_cavity(&self, p: DVec3) -> Option<Boundary> {
         let dom = &*self.dom;
         let (removed, faces) = dom.dt.probed_cavity();
+        // Every vertex of a cavity tet is on the cavity's boundary, and a ring tet adds one
+        // vertex to a boundary face: if no boundary face has a vertex on the domain boundary,
+        // no cavity or ring tet has two, so the scan below would find no subsegment or
+        // subfacet (and, crossing or not, name none).
+        let on_boundary = |v: u32| v == INFINITE || dom.kind[v as usize] != VertexKind::Volume;
+        if !faces
+            .iter()
+            .any(|f| f.vertices().into_iter().any(on_boundary))
+        {
+            return None;
+        }
         let mut scan = BoundaryScan {
             p,
             removed,
