@@ -69,6 +69,7 @@ pub struct Refiner<'a> {
     pub stop_reason: Option<String>,
     /// cos(params.min_dihedral): a tet whose largest dihedral cosine exceeds it is a sliver.
     cos_min_dihedral: f64,
+    screen: SliverScreen,
 }
 
 impl<'a> Refiner<'a> {
@@ -88,6 +89,7 @@ impl<'a> Refiner<'a> {
             gave_up: 0,
             stop_reason: None,
             cos_min_dihedral: params.min_dihedral.to_radians().cos(),
+            screen: SliverScreen::new(params),
         }
     }
 
@@ -135,6 +137,9 @@ impl<'a> Refiner<'a> {
         let rho = circumradius / l2.sqrt();
         if rho > self.params.rho0 {
             return Ok(bad(RATIO, rho));
+        }
+        if self.screen.clearly_not_sliver(a, b, c, d) {
+            return Ok(None);
         }
         let (sigma, max_cos_dihedral) = sliver_measures(a, b, c, d, l2);
         Ok(if self.is_sliver_by(sigma, max_cos_dihedral) {
@@ -273,7 +278,9 @@ impl<'a> Refiner<'a> {
         if let Probe::Duplicate(_) = self.dom.dt.probe(p, hint) {
             return false;
         }
-        let (n_small, worst) = self.small_slivers(p, r);
+        let Some((n_small, worst)) = self.small_slivers(p, r, best.map(|b| b.n_small)) else {
+            return false; // more small slivers than the best
+        };
         if best.is_some_and(|b| (n_small, -worst) >= (b.n_small, -b.worst)) {
             return false; // not better: whether it breaks the boundary does not matter
         }
@@ -286,8 +293,8 @@ impl<'a> Refiner<'a> {
 
     /// Small slivers (circumradius <= b R, sigma < sigma0 or a small dihedral angle) inserting
     /// `p` would create, with the probed cavity of `p`, and the smallest 1 - cos(smallest
-    /// dihedral angle) among them.
-    fn small_slivers(&self, p: DVec3, r: f64) -> (usize, f64) {
+    /// dihedral angle) among them; None as soon as there are more than `limit`.
+    fn small_slivers(&self, p: DVec3, r: f64, limit: Option<usize>) -> Option<(usize, f64)> {
         let mut n = 0;
         let mut worst = f64::INFINITY;
         let max_r = self.params.b * r;
@@ -297,17 +304,22 @@ impl<'a> Refiner<'a> {
                 continue;
             }
             let [x, y, z] = [x, y, z].map(|v| self.dom.point(v));
-            // The sliver test first: most new tets pass it, and then their circumradius is
-            // not needed.
+            // The sliver test first (most new tets pass its screen), then the circumradius.
+            if self.screen.clearly_not_sliver(x, y, z, p) {
+                continue;
+            }
             let (sigma, max_cos) = sliver_measures(x, y, z, p, shortest_edge_sq(x, y, z, p));
             if self.is_sliver_by(sigma, max_cos)
                 && circumsphere(x, y, z, p).map_or(f64::INFINITY, |s| s.1) <= max_r
             {
                 n += 1;
+                if limit.is_some_and(|m| n > m) {
+                    return None;
+                }
                 worst = worst.min(max_cos.mul_add(-1.0, 1.0));
             }
         }
-        (n, worst)
+        Some((n, worst))
     }
 
     #[inline]
@@ -625,6 +637,65 @@ fn subsegment_balls(dom: &Domain, f: u32) -> Vec<(DVec3, f64)> {
         .collect()
 }
 
+/// A cheap sufficient condition for "not a sliver" (sigma >= sigma0 and every dihedral angle
+/// within [min_dihedral, 180 - min_dihedral]), in squares only: no square root, no division.
+/// It holds with a relative margin, so that [`sliver_measures`] would surely find the tet
+/// good too; the tets it does not clear (slivers and near misses) get the full measures.
+#[derive(Debug, Clone, Copy)]
+struct SliverScreen {
+    /// 36 sigma0^2 (1 + MARGIN): sigma >= sigma0 iff det^2 >= 36 sigma0^2 L^6.
+    sigma: f64,
+    /// sin^2(min_dihedral) (1 + MARGIN): the dihedral angle at edge e, between the faces
+    /// with normals (cross products) n_r and n_s, has sin = |det| |e| / (|n_r| |n_s|).
+    dihedral: f64,
+}
+
+impl SliverScreen {
+    const MARGIN: f64 = 1e-6;
+
+    fn new(params: &Params) -> Self {
+        let s0 = params.min_dihedral.to_radians().sin();
+        SliverScreen {
+            sigma: 36.0 * params.sigma0 * params.sigma0 * (1.0 + Self::MARGIN),
+            dihedral: s0 * s0 * (1.0 + Self::MARGIN),
+        }
+    }
+
+    #[inline]
+    fn clearly_not_sliver(&self, a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> bool {
+        let (u, v, w) = (b - a, c - a, d - a);
+        let det = u.dot(v.cross(w));
+        let det2 = det * det;
+        let e = [
+            u.length_squared(),
+            v.length_squared(),
+            w.length_squared(),
+            (c - b).length_squared(),
+            (d - b).length_squared(),
+            (d - c).length_squared(),
+        ];
+        let l2 = e[0].min(e[1]).min(e[2]).min(e[3]).min(e[4]).min(e[5]);
+        if det2 < self.sigma * (l2 * l2 * l2) {
+            return false;
+        }
+        // Squared normal lengths of the faces opposite a, b, c, d.
+        let n = [
+            (d - b).cross(c - b).length_squared(),
+            v.cross(w).length_squared(),
+            w.cross(u).length_squared(),
+            u.cross(v).length_squared(),
+        ];
+        // Edges ab, ac, ad, bc, bd, cd and the faces meeting there (opposite the other two).
+        let k = self.dihedral;
+        det2 * e[0] >= k * (n[2] * n[3])
+            && det2 * e[1] >= k * (n[1] * n[3])
+            && det2 * e[2] >= k * (n[1] * n[2])
+            && det2 * e[3] >= k * (n[0] * n[3])
+            && det2 * e[4] >= k * (n[0] * n[2])
+            && det2 * e[5] >= k * (n[0] * n[1])
+    }
+}
+
 /// A candidate point and the small slivers inserting it would create.
 #[derive(Debug, Clone, Copy)]
 struct Candidate {
@@ -705,6 +776,37 @@ impl BoundaryScan<'_> {
 mod tests {
     use super::*;
     use crate::geom::TetQuality;
+
+    #[test]
+    fn sliver_screen_clears_only_good_tets() {
+        let params = Params::default();
+        let screen = SliverScreen::new(&params);
+        let cos_min = params.min_dihedral.to_radians().cos();
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let mut cleared = 0;
+        let mut flagged = 0;
+        for k in 0..200_000 {
+            let mut p = [DVec3::ZERO; 4];
+            for q in p.iter_mut() {
+                *q = DVec3::new(rng.gen(), rng.gen(), rng.gen());
+            }
+            if k % 2 == 1 {
+                // Near-slivers and near-flat tets: squash the fourth vertex towards a plane.
+                let t: f64 = rng.gen::<f64>().powi(4);
+                p[3] = p[3].lerp((p[0] + p[1] + p[2]) / 3.0 + (p[3] - p[0]) * 0.01, 1.0 - t);
+            }
+            let s = Shape::of(p[0], p[1], p[2], p[3]);
+            let bad = s.sigma < params.sigma0 || s.max_cos_dihedral > cos_min;
+            if screen.clearly_not_sliver(p[0], p[1], p[2], p[3]) {
+                assert!(!bad, "{p:?}: cleared, sigma {} cos {}", s.sigma, s.max_cos_dihedral);
+                cleared += 1;
+            } else if !bad {
+                flagged += 1;
+            }
+        }
+        // It clears nearly every good tet (not those with a dihedral angle near 180 degrees).
+        assert!(cleared > 50_000 && flagged < cleared / 100, "{cleared} {flagged}");
+    }
 
     #[test]
     fn shape_agrees_with_tet_quality() {
