@@ -373,8 +373,12 @@ impl<'a> Refiner<'a> {
             scan.tet(dom, t, true);
         }
         // The ring: the tets across the cavity's boundary faces (a tet may come up more than
-        // once; the checks are idempotent).
+        // once; the checks are idempotent). One whose face has no boundary vertex has at most
+        // one (its apex).
         for f in faces {
+            if !f.vertices().into_iter().any(on_boundary) {
+                continue;
+            }
             let t = f.outer_tet();
             if dom.dt.is_finite(t) && dom.dt.tag(t) != 0 {
                 scan.tet(dom, t, false);
@@ -798,14 +802,21 @@ mod tests {
             let s = Shape::of(p[0], p[1], p[2], p[3]);
             let bad = s.sigma < params.sigma0 || s.max_cos_dihedral > cos_min;
             if screen.clearly_not_sliver(p[0], p[1], p[2], p[3]) {
-                assert!(!bad, "{p:?}: cleared, sigma {} cos {}", s.sigma, s.max_cos_dihedral);
+                assert!(
+                    !bad,
+                    "{p:?}: cleared, sigma {} cos {}",
+                    s.sigma, s.max_cos_dihedral
+                );
                 cleared += 1;
             } else if !bad {
                 flagged += 1;
             }
         }
         // It clears nearly every good tet (not those with a dihedral angle near 180 degrees).
-        assert!(cleared > 50_000 && flagged < cleared / 100, "{cleared} {flagged}");
+        assert!(
+            cleared > 50_000 && flagged < cleared / 100,
+            "{cleared} {flagged}"
+        );
     }
 
     #[test]
