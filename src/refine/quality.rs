@@ -9,7 +9,7 @@ use super::domain::{seg_key, tri_key, Domain, VertexKind};
 use super::mark::Regions;
 use super::{MeshError, Params, Spacing};
 use crate::delaunay::{tables::FACE, Probe, INFINITE};
-use crate::geom::{circumsphere, diametric_ball, equatorial_ball, tri_circumcenter};
+use crate::geom::{circumsphere, diametric_ball, equatorial_ball, orient3d, tri_circumcenter};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -125,20 +125,42 @@ impl<'a> Refiner<'a> {
                 verts,
             })
         };
-        // Shape::of's measures, each computed only when the tests before it pass.
-        let Some((centre, circumradius)) = circumsphere(a, b, c, d) else {
+        // Shape::of's measures, each computed only when the tests before it pass, sharing the
+        // edge vectors and cross products: the circumsphere exactly as geom::circumsphere
+        // computes it, then the sliver screen.
+        let (u, v, w) = (b - a, c - a, d - a);
+        let (vw, wu, uv) = (v.cross(w), w.cross(u), u.cross(v));
+        let lu = [u.length_squared(), v.length_squared(), w.length_squared()];
+        let det = orient3d(a, b, c, d);
+        let offset = (lu[0] * vw + lu[1] * wu + lu[2] * uv) * (0.5 / det);
+        if det == 0.0 || !offset.is_finite() {
             return Ok(bad(SLIVER, f64::INFINITY));
-        };
+        }
+        let (centre, circumradius) = (a + offset, offset.length());
         let xi = circumradius / self.spacing_at(centre, tag)?;
         if xi > self.params.size_factor {
             return Ok(bad(SIZE, xi));
         }
-        let l2 = shortest_edge_sq(a, b, c, d);
+        let e = [
+            lu[0],
+            lu[1],
+            lu[2],
+            (c - b).length_squared(),
+            (d - b).length_squared(),
+            (d - c).length_squared(),
+        ];
+        let l2 = e[0].min(e[1]).min(e[2]).min(e[3]).min(e[4]).min(e[5]);
         let rho = circumradius / l2.sqrt();
         if rho > self.params.rho0 {
             return Ok(bad(RATIO, rho));
         }
-        if self.screen.clearly_not_sliver(a, b, c, d) {
+        let n = [
+            (d - b).cross(c - b).length_squared(),
+            vw.length_squared(),
+            wu.length_squared(),
+            uv.length_squared(),
+        ];
+        if self.screen.clears(det, e, l2, n) {
             return Ok(None);
         }
         let (sigma, max_cos_dihedral) = sliver_measures(a, b, c, d, l2);
@@ -449,9 +471,18 @@ impl<'a> Refiner<'a> {
                     self.gave_up += 1;
                     return Ok(());
                 };
-                let cf = self.dom.snap_to_facet_plane(f, cf);
-                let enc = self.dom.facet_subsegments_encroached_by(f, cf);
-                if let Some(&(a, c)) = enc.first() {
+                // The facet's plane snap and subsegment balls, once for the centre and all
+                // the draws (the same tests as snap_to_facet_plane and
+                // facet_subsegments_encroached_by, which walk the whole facet).
+                let snap = PlaneSnap::of(self.dom, f);
+                let balls = subsegment_balls(self.dom, f);
+                let cf = snap.apply(cf);
+                let enc = balls
+                    .iter()
+                    .filter(|b| cf.distance_squared(b.centre) <= b.r2)
+                    .map(|b| b.key)
+                    .min();
+                if let Some((a, c)) = enc {
                     self.split_segment_picked(a, c)?;
                 } else if self.dom.facets[f as usize].locate(cf).is_none() {
                     self.gave_up += 1;
@@ -461,11 +492,6 @@ impl<'a> Refiner<'a> {
                     let n = (y - x).cross(z - x).normalize();
                     let u = (y - x).normalize();
                     let w = n.cross(u);
-                    // The facet's plane snap and subsegment balls, once for all the draws
-                    // (the same tests as snap_to_facet_plane and
-                    // facet_subsegments_encroached_by, which walk the whole facet).
-                    let snap = PlaneSnap::of(self.dom, f);
-                    let balls = subsegment_balls(self.dom, f);
                     let mut best = None;
                     for _ in 0..self.params.max_tries.max(1) {
                         let (s, th) = (
@@ -475,7 +501,7 @@ impl<'a> Refiner<'a> {
                         let p = cf + (u * th.cos() + w * th.sin()) * (s * self.params.delta * rf);
                         let p = snap.apply(p);
                         if self.dom.facets[f as usize].locate(p).is_none()
-                            || balls.iter().any(|&(c, r2)| p.distance_squared(c) <= r2)
+                            || balls.iter().any(|b| p.distance_squared(b.centre) <= b.r2)
                         {
                             continue;
                         }
@@ -628,15 +654,26 @@ impl PlaneSnap {
     }
 }
 
-/// The closed diametric balls of facet `f`'s subsegments, slightly inflated, as
-/// [`Domain::facet_subsegments_encroached_by`] tests them: (centre, squared radius).
-fn subsegment_balls(dom: &Domain, f: u32) -> Vec<(DVec3, f64)> {
+/// A subsegment's closed diametric ball, slightly inflated, as
+/// [`Domain::facet_subsegments_encroached_by`] tests it.
+struct SubsegmentBall {
+    key: (u32, u32),
+    centre: DVec3,
+    r2: f64,
+}
+
+/// The balls of facet `f`'s subsegments.
+fn subsegment_balls(dom: &Domain, f: u32) -> Vec<SubsegmentBall> {
     dom.facets[f as usize]
         .constrained_edges()
         .into_iter()
         .map(|[x, y]| {
-            let (c, r) = diametric_ball(dom.point(x), dom.point(y));
-            (c, r * r * (1.0 + 1e-9))
+            let (centre, r) = diametric_ball(dom.point(x), dom.point(y));
+            SubsegmentBall {
+                key: seg_key(x, y),
+                centre,
+                r2: r * r * (1.0 + 1e-9),
+            }
         })
         .collect()
 }
@@ -669,7 +706,6 @@ impl SliverScreen {
     fn clearly_not_sliver(&self, a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> bool {
         let (u, v, w) = (b - a, c - a, d - a);
         let det = u.dot(v.cross(w));
-        let det2 = det * det;
         let e = [
             u.length_squared(),
             v.length_squared(),
@@ -679,16 +715,27 @@ impl SliverScreen {
             (d - c).length_squared(),
         ];
         let l2 = e[0].min(e[1]).min(e[2]).min(e[3]).min(e[4]).min(e[5]);
-        if det2 < self.sigma * (l2 * l2 * l2) {
+        if det * det < self.sigma * (l2 * l2 * l2) {
             return false;
         }
-        // Squared normal lengths of the faces opposite a, b, c, d.
         let n = [
             (d - b).cross(c - b).length_squared(),
             v.cross(w).length_squared(),
             w.cross(u).length_squared(),
             u.cross(v).length_squared(),
         ];
+        self.clears(det, e, l2, n)
+    }
+
+    /// The screen from the tet's pieces: `det` = det[b-a, c-a, d-a] (up to a relative error
+    /// far below the margin), the squared edge lengths `e` (ab, ac, ad, bc, bd, cd), the
+    /// shortest `l2` and the squared normal lengths `n` of the faces opposite a, b, c, d.
+    #[inline]
+    fn clears(&self, det: f64, e: [f64; 6], l2: f64, n: [f64; 4]) -> bool {
+        let det2 = det * det;
+        if det2 < self.sigma * (l2 * l2 * l2) {
+            return false;
+        }
         // Edges ab, ac, ad, bc, bd, cd and the faces meeting there (opposite the other two).
         let k = self.dihedral;
         det2 * e[0] >= k * (n[2] * n[3])
