@@ -779,13 +779,17 @@ impl BoundaryScan<'_> {
     #[inline]
     fn tet(&mut self, dom: &Domain, t: u32, in_cavity: bool) {
         let v = dom.dt.tet(t);
-        let on_boundary = v.map(|x| dom.kind[x as usize] != VertexKind::Volume);
-        if on_boundary.iter().filter(|&&b| b).count() < 2 {
+        let kind = v.map(|x| dom.kind[x as usize]);
+        let on_boundary = kind.map(|k| k != VertexKind::Volume);
+        let n_boundary = on_boundary.iter().filter(|&&b| b).count();
+        if n_boundary < 2 {
             return; // no subsegment or subfacet among its edges and faces
         }
+        // Subsegments join input and segment vertices only.
+        let on_segment = kind.map(|k| matches!(k, VertexKind::Input | VertexKind::Segment(_)));
         for i in 0..4 {
             for j in i + 1..4 {
-                if !(on_boundary[i] && on_boundary[j]) {
+                if !(on_segment[i] && on_segment[j]) {
                     continue;
                 }
                 let k = seg_key(v[i], v[j]);
@@ -797,8 +801,10 @@ impl BoundaryScan<'_> {
                     self.seg = Some(k);
                 }
             }
-            if on_boundary[i] {
-                continue; // face i is opposite vertex i: it holds the other three
+            if on_boundary[i] || n_boundary < 3 {
+                // Face i is opposite vertex i: it holds the other three (with fewer than
+                // three boundary vertices, one of them is a volume vertex).
+                continue;
             }
             let f = tri_key(FACE[i].map(|l| v[l]));
             let Some(&fi) = dom.subfacets.get(&f) else {
