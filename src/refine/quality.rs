@@ -1,7 +1,8 @@
 //! "Clean Bad Elements" (the paper's REMOVE-SLIVER main loop): size-bad tets (R / f(c) > B)
 //! first, then radius-edge-bad (rho > rho0), then slivers (sigma < sigma0). A bad tet is
-//! refined from a random point of its picking ball (c, delta R) chosen, among `max_tries`
-//! draws, to create no small sliver (a new sliver with circumradius <= b R); when its
+//! refined from a point of its picking ball (c, delta R) that creates no small sliver (a new
+//! sliver with circumradius <= b R): the centre c itself if it does not (its cavity is known
+//! from the boundary check), else the best of up to `max_tries` random draws; when its
 //! circumcentre encroaches a subsegment or subfacet, that boundary element is split from its
 //! own picking interval or disk instead.
 
@@ -254,10 +255,23 @@ impl<'a> Refiner<'a> {
         // Draw candidates from the picking ball; keep the one with fewest small slivers among
         // those that break no boundary.
         let mut best = None;
-        for _ in 0..self.params.max_tries.max(1) {
-            let p = centre + self.random_in_ball() * (self.params.delta * r);
-            if self.try_candidate(p, r, Some(bad.tet), None, &mut best) {
-                break;
+        // The centre is a point of the picking ball too, and its cavity is at hand (probed by
+        // the boundary check above, which it passed): the first candidate.
+        if !self.dom.dt.probed_cavity().1.is_empty() {
+            if let Some((n_small, worst)) = self.small_slivers(centre, r, None) {
+                best = Some(Candidate {
+                    n_small,
+                    worst,
+                    p: centre,
+                });
+            }
+        }
+        if best.is_none_or(|b| b.n_small > 0) {
+            for _ in 0..self.params.max_tries.max(1) {
+                let p = centre + self.random_in_ball() * (self.params.delta * r);
+                if self.try_candidate(p, r, Some(bad.tet), None, &mut best) {
+                    break;
+                }
             }
         }
         // The chosen point breaks no boundary: a candidate was only kept after that check on
