@@ -506,8 +506,15 @@ impl<'a> Refiner<'a> {
                     let n = (y - x).cross(z - x).normalize();
                     let u = (y - x).normalize();
                     let w = n.cross(u);
+                    // The centre first (it passed the facet checks above), then random draws.
                     let mut best = None;
-                    for _ in 0..self.params.max_tries.max(1) {
+                    let hint = self.dom.dt.vertex_tet(t[0]);
+                    let centre_ok = self.try_candidate(cf, rf, hint, Some(b), &mut best);
+                    for _ in 0..if centre_ok {
+                        0
+                    } else {
+                        self.params.max_tries.max(1)
+                    } {
                         let (s, th) = (
                             self.rng.gen::<f64>().sqrt(),
                             self.rng.gen::<f64>() * std::f64::consts::TAU,
