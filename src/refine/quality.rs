@@ -1017,6 +1017,7 @@ mod tests {
                 assert!((s.max_cos_dihedral - q.min_dihedral.to_radians().cos()).abs() < 1e-12);
                 assert!((s.sigma - q.sigma).abs() < 1e-12 * q.sigma.max(1.0));
                 assert!((s.circumradius - q.circumradius).abs() < 1e-12);
+                assert!((s.shortest_edge - q.shortest_edge).abs() < 1e-12);
             }
         }
     }
