@@ -569,7 +569,8 @@ impl SmallSet {
     #[inline]
     fn insert(&mut self, t: u32) -> bool {
         debug_assert!(t != Self::EMPTY);
-        let mut slot = (t.wrapping_mul(0x9E37_79B1) >> 24) as usize;
+        let mut slot =
+            (t.wrapping_mul(0x9E37_79B1) >> (32 - Self::SLOTS.trailing_zeros())) as usize;
         loop {
             let e = self.table[slot];
             if e == t {
