@@ -904,9 +904,9 @@ impl BoundaryScan<'_> {
                     self.seg = Some(k);
                 }
             }
-            if on_boundary[i] || n_boundary < 3 {
-                // Face i is opposite vertex i: it holds the other three (with fewer than
-                // three boundary vertices, one of them is a volume vertex).
+            // Face i is opposite vertex i: it holds the other three, which must all lie on
+            // the boundary for it to be a subfacet.
+            if n_boundary < 3 || (n_boundary == 3 && on_boundary[i]) {
                 continue;
             }
             let f = tri_key(FACE[i].map(|l| v[l]));
