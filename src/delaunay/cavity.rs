@@ -28,6 +28,10 @@ pub(super) struct Scratch {
     tags: Vec<u32>,
     /// Directed boundary edge -> face reference of the new tet that owns it.
     edges: EdgeTable,
+    /// The point whose cavity `cavity` and `boundary` hold, when they were computed by a
+    /// probe ([`Delaunay::probe`]) and the triangulation has not changed since: inserting
+    /// exactly this point then reuses them.
+    probed: Option<DVec3>,
 }
 
 impl Scratch {
@@ -46,10 +50,38 @@ impl Scratch {
 /// be reused): its vertices as seen from inside the cavity (`FACE` order of the owner), the
 /// reference to the outer neighbour's face, and the owner.
 #[derive(Debug, Clone, Copy, Default)]
-pub(super) struct BoundaryFace {
+pub struct BoundaryFace {
     v: [u32; 3],
     outer: u32,
     owner: u32,
+}
+
+impl BoundaryFace {
+    /// The face's vertices, positively oriented with the new point: the tet `(a, b, c, p)` is
+    /// the one inserting p creates on it (a face holding `INFINITE` makes a hull tet).
+    #[inline]
+    pub fn vertices(&self) -> [u32; 3] {
+        self.v
+    }
+    /// The tet outside the cavity across this face (it survives the insertion).
+    #[inline]
+    pub fn outer_tet(&self) -> u32 {
+        self.outer >> 2
+    }
+    /// The cavity tet this face belongs to.
+    #[inline]
+    pub fn owner(&self) -> u32 {
+        self.owner
+    }
+}
+
+/// What a probe found (see [`Delaunay::probe`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Probe {
+    /// The point equals this vertex.
+    Duplicate(u32),
+    /// The cavity is available from [`Delaunay::probed_cavity`].
+    Cavity,
 }
 
 /// Cavity search marks (zero: not visited).
@@ -85,22 +117,60 @@ impl Delaunay {
         Inserted::New(id)
     }
 
+    /// Inserts the new vertex `id` (the last id) at the point of the last probe, whose cavity
+    /// is still in the scratch buffers; false (nothing done) if there is none for that point.
+    pub(super) fn insert_probed(&mut self, id: u32) -> bool {
+        debug_assert_eq!(id as usize + 1, self.points.len());
+        if self.scratch.probed != Some(self.points[id as usize]) {
+            return false;
+        }
+        // The probe ranked the would-be vertex as `points.len()` before the push: `id`.
+        self.fill_cavity(id);
+        self.n_vertices += 1;
+        true
+    }
+
     /// The tets a new point at `p` would remove and the faces it would connect to, without
-    /// changing the triangulation (refinement tests candidate points with this). `hint` is a
-    /// tet to start the walk from (any alive tet).
+    /// changing the triangulation. `hint` is a tet to start the walk from (any alive tet).
+    /// Allocates; [`Self::probe`] and [`Self::probed_cavity`] do the same in place.
     pub fn dry_run(&mut self, p: DVec3, hint: Option<u32>) -> DryRun {
+        match self.probe(p, hint) {
+            Probe::Duplicate(v) => DryRun::Duplicate(v),
+            Probe::Cavity => {
+                let (removed, faces) = self.probed_cavity();
+                DryRun::Cavity {
+                    removed: removed.to_vec(),
+                    faces: faces.iter().map(|f| f.v).collect(),
+                }
+            }
+        }
+    }
+
+    /// Computes the cavity a new point at `p` would have, without changing the triangulation
+    /// (refinement tests candidate points with this); read it with [`Self::probed_cavity`].
+    /// `hint` is a tet to start the walk from (any alive tet). Until the next probe or change,
+    /// [`Self::insert`] of exactly `p` reuses this cavity instead of searching again.
+    pub fn probe(&mut self, p: DVec3, hint: Option<u32>) -> Probe {
         let hint = hint.filter(|&t| self.is_alive(t)).unwrap_or(self.last);
         let start = self.locate(p, hint);
         if let Some(dup) = self.coincident_vertex(start, p) {
-            return DryRun::Duplicate(dup);
+            self.scratch.probed = None;
+            return Probe::Duplicate(dup);
         }
         // The would-be vertex ranks above every existing one, as a real insertion would.
         self.find_cavity(p, self.points.len() as u32, start);
-        let faces = self.scratch.boundary.iter().map(|f| f.v).collect();
-        DryRun::Cavity {
-            removed: self.scratch.cavity.clone(),
-            faces,
+        self.scratch.probed = Some(p);
+        Probe::Cavity
+    }
+
+    /// The cavity of the last [`Self::probe`] that found one: the tets inserting the point
+    /// would delete, and the cavity's boundary faces (one new tet each). Empty when the
+    /// triangulation changed since.
+    pub fn probed_cavity(&self) -> (&[u32], &[BoundaryFace]) {
+        if self.scratch.probed.is_none() {
+            return (&[], &[]);
         }
+        (&self.scratch.cavity, &self.scratch.boundary)
     }
 
     fn coincident_vertex(&self, t: u32, p: DVec3) -> Option<u32> {
@@ -152,6 +222,7 @@ impl Delaunay {
     /// it is dequeued and they are tested.
     fn find_cavity(&mut self, p: DVec3, rank: u32, start: u32) {
         let mut s = std::mem::take(&mut self.scratch);
+        s.probed = None;
         s.cavity.clear();
         s.entry.clear();
         s.boundary.clear();
@@ -322,6 +393,7 @@ impl Delaunay {
     /// in a small open-addressing table.
     fn fill_cavity(&mut self, id: u32) {
         let mut s = std::mem::take(&mut self.scratch);
+        s.probed = None;
         // Remember the deleted tets (refinement re-checks the boundary elements they held).
         s.removed.clear();
         for &t in &s.cavity {

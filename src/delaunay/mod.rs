@@ -19,7 +19,7 @@ pub mod tables;
 mod validate;
 
 use crate::geom::{self, orient3d};
-pub use cavity::DryRun;
+pub use cavity::{BoundaryFace, DryRun, Probe};
 use glam::DVec3;
 use tables::FACE;
 
@@ -179,6 +179,9 @@ impl Delaunay {
         self.points.push(p);
         self.vertex_tet.push(NO_TET);
         self.rank.push(index as u32);
+        if self.insert_probed(index as u32) {
+            return Ok(Inserted::New(index as u32));
+        }
         let hint = match hint.filter(|&t| self.is_alive(t)) {
             Some(t) => t,
             None => self.hint_towards(p),
@@ -303,43 +306,39 @@ impl Delaunay {
     /// All alive tets incident to vertex `v` (hull tets included).
     pub fn vertex_star(&self, v: u32) -> Vec<u32> {
         let mut star = vec![];
-        self.search_star(v, |t| {
-            star.push(t);
-            false
-        });
+        self.search_star(v, &mut star, |_| false);
         star
     }
 
-    /// Visits the tets incident to vertex `v` (breadth first from `vertex_tet(v)`) until
-    /// `found` says stop; returns that tet.
-    fn search_star(&self, v: u32, mut found: impl FnMut(u32) -> bool) -> Option<u32> {
+    /// Breadth-first search of the star of vertex `v` (the order [`Self::vertex_star`] lists
+    /// it in) for the first tet whose vertices satisfy `hit`; `star` receives the tets visited.
+    #[inline]
+    fn search_star(
+        &self,
+        v: u32,
+        star: &mut Vec<u32>,
+        mut hit: impl FnMut(&[u32; 4]) -> bool,
+    ) -> Option<u32> {
+        star.clear();
         let start = self.vertex_tet(v)?;
-        let mut star = vec![start];
-        // Small stars: a linear scan is fastest; large ones (an apex of many subsegments can
-        // hold thousands of tets) need a set, or the search is quadratic.
-        let mut seen: Option<rustc_hash::FxHashSet<u32>> = None;
+        let mut seen = SmallSet::new();
+        seen.insert(start);
+        star.push(start);
         let mut k = 0;
         while k < star.len() {
             let t = star[k];
             k += 1;
-            if found(t) {
+            let Tet { v: tv, n } = *self.tet_ref(t);
+            if hit(&tv) {
                 return Some(t);
             }
-            let tv = self.tets[t as usize].v;
             for (i, &w) in tv.iter().enumerate() {
                 if w == v {
                     continue; // the face opposite v does not contain v
                 }
-                let n = self.tets[t as usize].n[i] >> 2;
-                let new = match &mut seen {
-                    Some(set) => set.insert(n),
-                    None => !star.contains(&n),
-                };
-                if new {
-                    star.push(n);
-                    if seen.is_none() && star.len() > 48 {
-                        seen = Some(star.iter().copied().collect());
-                    }
+                let m = n[i] >> 2;
+                if seen.insert(m) {
+                    star.push(m);
                 }
             }
         }
@@ -348,13 +347,12 @@ impl Delaunay {
 
     /// A tet having both `a` and `b` as vertices (i.e. edge ab exists), if any.
     pub fn find_edge(&self, a: u32, b: u32) -> Option<u32> {
-        self.search_star(a, |t| self.tets[t as usize].v.contains(&b))
+        self.search_star(a, &mut Vec::with_capacity(64), |v| v.contains(&b))
     }
 
     /// The tets (one or two) having face abc, with the local index of their fourth vertex.
     pub fn find_face(&self, a: u32, b: u32, c: u32) -> Option<[(u32, usize); 2]> {
-        let t = self.search_star(a, |t| {
-            let v = self.tets[t as usize].v;
+        let t = self.search_star(a, &mut Vec::with_capacity(64), |v| {
             v.contains(&b) && v.contains(&c)
         })?;
         let v = self.tets[t as usize].v;
@@ -491,13 +489,17 @@ impl Delaunay {
         self.tets[(from >> 2) as usize].n[(from & 3) as usize] = to;
     }
 
-    /// Makes room for one more tet slot, growing the arrays by 1/8 (not Vec's doubling, which
-    /// would nearly double the peak memory when a big triangulation barely outgrows its
-    /// reservation).
+    /// Makes room for one more tet slot. Small arrays double (refinement grows a triangulation
+    /// from a few tets by single insertions: growing by small steps would copy it many times
+    /// over); from `GROW_BY_EIGHTHS` tets on they grow by 1/8 (doubling would nearly double the
+    /// peak memory when a big triangulation barely outgrows its reservation).
     #[inline]
     fn grow_tets(&mut self) {
+        /// 2^20 tets: 33 MiB of tet records and marks.
+        const GROW_BY_EIGHTHS: usize = 1 << 20;
         if self.tets.len() == self.tets.capacity() {
-            let extra = self.tets.len() / 8 + 1024;
+            let len = self.tets.len();
+            let extra = if len < GROW_BY_EIGHTHS { len } else { len / 8 } + 1024;
             self.tets.reserve_exact(extra);
             self.mark.reserve_exact(extra);
             if self.tags_enabled {
@@ -537,6 +539,55 @@ impl Delaunay {
         x ^= x << 5;
         self.rng = x;
         x
+    }
+}
+
+/// A set of tet ids for walking a vertex star: open addressing in a fixed table on the stack
+/// (no allocation, no clearing of a big array); beyond its capacity, a heap set.
+struct SmallSet {
+    table: [u32; SmallSet::SLOTS],
+    len: usize,
+    overflow: Option<rustc_hash::FxHashSet<u32>>,
+}
+
+impl SmallSet {
+    const SLOTS: usize = 256;
+    /// Entries kept in the table (load factor <= 1/2).
+    const MAX_LEN: usize = Self::SLOTS / 2;
+    const EMPTY: u32 = u32::MAX;
+
+    #[inline]
+    fn new() -> Self {
+        SmallSet {
+            table: [Self::EMPTY; Self::SLOTS],
+            len: 0,
+            overflow: None,
+        }
+    }
+
+    /// Adds `t`; false if it was there already.
+    #[inline]
+    fn insert(&mut self, t: u32) -> bool {
+        debug_assert!(t != Self::EMPTY);
+        let mut slot =
+            (t.wrapping_mul(0x9E37_79B1) >> (32 - Self::SLOTS.trailing_zeros())) as usize;
+        loop {
+            let e = self.table[slot];
+            if e == t {
+                return false;
+            }
+            if e == Self::EMPTY {
+                break;
+            }
+            slot = (slot + 1) & (Self::SLOTS - 1);
+        }
+        if self.len < Self::MAX_LEN {
+            self.table[slot] = t;
+            self.len += 1;
+            true
+        } else {
+            self.overflow.get_or_insert_with(Default::default).insert(t)
+        }
     }
 }
 

@@ -338,3 +338,66 @@ fn tags_are_inherited_through_cavities() {
     assert!(checked > 100, "{checked}");
     dt.validate().unwrap();
 }
+
+#[test]
+fn insertion_reuses_only_the_cavity_of_the_same_point() {
+    let pts = uniform(2000, 13);
+    let (mut dt, _) = Delaunay::from_points(&pts).unwrap();
+    let mut reference = dt.clone();
+    let new = uniform(200, 14);
+    for (k, pair) in new.chunks(2).enumerate() {
+        let (p, q) = (pair[0], pair[1]);
+        // Probe p then q; insert p (the scratch holds q's cavity: no reuse), then probe and
+        // insert q (reuse); or, every other round, insert q right after its probe.
+        assert_eq!(dt.probe(p, None), Probe::Cavity);
+        assert_eq!(dt.probe(q, None), Probe::Cavity);
+        let (removed, faces) = dt.probed_cavity();
+        assert!(!removed.is_empty() && !faces.is_empty());
+        let order = if k % 2 == 0 { [p, q] } else { [q, p] };
+        for x in order {
+            if x == p && k % 2 == 0 {
+                dt.probe(x, None);
+            }
+            dt.insert(x, None).unwrap();
+            reference.insert(x, None).unwrap();
+            // After a change, no probed cavity is offered.
+            assert!(dt.probed_cavity().0.is_empty());
+        }
+    }
+    dt.validate().unwrap();
+    let sorted = |dt: &Delaunay| {
+        let mut t: Vec<[u32; 4]> = dt
+            .finite_tets()
+            .map(|mut t| {
+                t.sort_unstable();
+                t
+            })
+            .collect();
+        t.sort_unstable();
+        t
+    };
+    assert_eq!(sorted(&dt), sorted(&reference));
+}
+
+#[test]
+fn vertex_star_of_a_high_degree_vertex() {
+    // The centre of a sphere of points is in every tet: its star overflows the small set.
+    let mut pts = sphere(400, 15);
+    pts.push(DVec3::ZERO);
+    let (dt, _) = Delaunay::from_points(&pts).unwrap();
+    let c = (pts.len() - 1) as u32;
+    let mut star = dt.vertex_star(c);
+    star.sort_unstable();
+    let mut expected: Vec<u32> = (0..dt.tet_capacity() as u32)
+        .filter(|&t| dt.is_alive(t) && dt.tet(t).contains(&c))
+        .collect();
+    expected.sort_unstable();
+    assert!(expected.len() > 300, "{}", expected.len());
+    assert_eq!(star, expected);
+    for v in 0..400u32 {
+        let t = dt
+            .find_edge(c, v)
+            .expect("every sphere point is joined to the centre");
+        assert!(dt.tet(t).contains(&c) && dt.tet(t).contains(&v));
+    }
+}

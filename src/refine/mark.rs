@@ -3,7 +3,7 @@
 //! a region seed), and give each the attribute of its region seed. Each tet's kernel tag names
 //! its component (0 = outside), so tets created later inherit it.
 
-use super::domain::{tri_key, Domain};
+use super::domain::{tri_key, Domain, VertexKind};
 use super::MeshError;
 use crate::delaunay::{tables::FACE, INFINITE};
 use crate::plc::PlcInput;
@@ -25,45 +25,54 @@ pub enum Unseeded {
 }
 
 impl Domain {
-    /// Whether face `i` of tet `t` is a subfacet.
-    pub fn is_subfacet_face(&self, t: u32, i: usize) -> bool {
-        let v = self.dt.tet(t);
-        let f = FACE[i].map(|k| v[k]);
-        !f.contains(&INFINITE) && self.subfacets.contains_key(&tri_key(f))
-    }
-
     pub fn mark_domain(
         &mut self,
         input: &PlcInput,
         unseeded: Unseeded,
     ) -> Result<Regions, MeshError> {
         let cap = self.dt.tet_capacity();
+        // Only a face whose three vertices lie on the boundary can be a subfacet: test that
+        // before the hash lookup (most faces have a volume vertex).
+        let on_boundary: Vec<bool> = self.kind.iter().map(|&k| k != VertexKind::Volume).collect();
+        let is_subfacet = |f: [u32; 3]| {
+            !f.contains(&INFINITE)
+                && f.iter().all(|&x| on_boundary[x as usize])
+                && self.subfacets.contains_key(&tri_key(f))
+        };
+        // Union-find over the faces that are not subfacets, scanning the tets in memory order
+        // (a flood fill would visit them in a cache-hostile order). Each face once: from the
+        // tet with the smaller id.
+        let mut parent: Vec<u32> = (0..cap as u32).collect();
+        for t in 0..cap as u32 {
+            if !self.dt.is_alive(t) {
+                continue;
+            }
+            let v = self.dt.tet(t);
+            for (i, n) in self.dt.neighbors(t).into_iter().enumerate() {
+                if n > t && !is_subfacet(FACE[i].map(|k| v[k])) {
+                    union(&mut parent, t, n);
+                }
+            }
+        }
+        // Components numbered in the order of their smallest tet id.
         let mut comp = vec![u32::MAX; cap];
         let mut outside = vec![];
         let mut n_comp = 0u32;
-        let mut stack = vec![];
-        for start in 0..cap as u32 {
-            if !self.dt.is_alive(start) || comp[start as usize] != u32::MAX {
+        for t in 0..cap as u32 {
+            if !self.dt.is_alive(t) {
                 continue;
             }
-            let id = n_comp;
-            n_comp += 1;
-            let mut touches_hull = false;
-            comp[start as usize] = id;
-            stack.push(start);
-            while let Some(t) = stack.pop() {
-                if !self.dt.is_finite(t) {
-                    touches_hull = true;
-                }
-                let nb = self.dt.neighbors(t);
-                for (i, &n) in nb.iter().enumerate() {
-                    if comp[n as usize] == u32::MAX && !self.is_subfacet_face(t, i) {
-                        comp[n as usize] = id;
-                        stack.push(n);
-                    }
-                }
+            let r = find(&mut parent, t) as usize;
+            if comp[r] == u32::MAX {
+                comp[r] = n_comp;
+                n_comp += 1;
+                outside.push(false);
             }
-            outside.push(touches_hull);
+            let c = comp[r];
+            comp[t as usize] = c;
+            if !self.dt.is_finite(t) {
+                outside[c as usize] = true; // touches the hull
+            }
         }
         let mut attribute: Vec<Option<i32>> = vec![None; n_comp as usize];
         let mut max_size: Vec<Option<f64>> = vec![None; n_comp as usize];
@@ -119,5 +128,27 @@ impl Domain {
             }
         }
         Ok(regions)
+    }
+}
+
+/// Union-find root of `t`, halving the path on the way.
+#[inline]
+fn find(parent: &mut [u32], mut t: u32) -> u32 {
+    while parent[t as usize] != t {
+        let g = parent[parent[t as usize] as usize];
+        parent[t as usize] = g;
+        t = g;
+    }
+    t
+}
+
+#[inline]
+fn union(parent: &mut [u32], a: u32, b: u32) {
+    let (ra, rb) = (find(parent, a), find(parent, b));
+    // The smaller id becomes the root.
+    if ra < rb {
+        parent[rb as usize] = ra;
+    } else if rb < ra {
+        parent[ra as usize] = rb;
     }
 }

@@ -1,15 +1,16 @@
 //! "Clean Bad Elements" (the paper's REMOVE-SLIVER main loop): size-bad tets (R / f(c) > B)
 //! first, then radius-edge-bad (rho > rho0), then slivers (sigma < sigma0). A bad tet is
-//! refined from a random point of its picking ball (c, delta R) chosen, among `max_tries`
-//! draws, to create no small sliver (a new sliver with circumradius <= b R); when its
+//! refined from a point of its picking ball (c, delta R) that creates no small sliver (a new
+//! sliver with circumradius <= b R): the centre c itself if it does not (its cavity is known
+//! from the boundary check), else the best of up to `max_tries` random draws; when its
 //! circumcentre encroaches a subsegment or subfacet, that boundary element is split from its
 //! own picking interval or disk instead.
 
 use super::domain::{seg_key, tri_key, Domain, VertexKind};
 use super::mark::Regions;
 use super::{MeshError, Params, Spacing};
-use crate::delaunay::{tables::FACE, DryRun, INFINITE};
-use crate::geom::{diametric_ball, equatorial_ball, tri_circumcenter};
+use crate::delaunay::{tables::FACE, Probe, INFINITE};
+use crate::geom::{circumsphere, diametric_ball, equatorial_ball, orient3d, tri_circumcenter};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -75,6 +76,7 @@ pub struct Refiner<'a> {
     cos_min_dihedral: f64,
     /// The bounding box of the input vertices.
     domain_box: BoundingBox,
+    screen: SliverScreen,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -117,6 +119,7 @@ impl<'a> Refiner<'a> {
             stop_reason: None,
             cos_min_dihedral: params.min_dihedral.to_radians().cos(),
             domain_box: BoundingBox { lo, hi },
+            screen: SliverScreen::new(params),
         }
     }
 
@@ -142,9 +145,8 @@ impl<'a> Refiner<'a> {
         if tag == 0 || !self.dom.dt.is_finite(t) {
             return Ok(None);
         }
-        let [a, b, c, d] = self.dom.dt.tet_points(t);
-        let s = Shape::of(a, b, c, d);
         let verts = self.dom.dt.tet(t);
+        let [a, b, c, d] = verts.map(|v| self.dom.point(v));
         let bad = |class, badness| {
             Some(Bad {
                 class,
@@ -166,17 +168,47 @@ impl<'a> Refiner<'a> {
                 verts,
             }));
         }
-        let Some(centre) = s.circumcenter else {
+        // Shape::of's measures, each computed only when the tests before it pass, sharing the
+        // edge vectors and cross products: the circumsphere exactly as geom::circumsphere
+        // computes it, then the sliver screen.
+        let (u, v, w) = (b - a, c - a, d - a);
+        let (vw, wu, uv) = (v.cross(w), w.cross(u), u.cross(v));
+        let lu = [u.length_squared(), v.length_squared(), w.length_squared()];
+        let det = orient3d(a, b, c, d);
+        let offset = (lu[0] * vw + lu[1] * wu + lu[2] * uv) * (0.5 / det);
+        if det == 0.0 || !offset.is_finite() {
             return Ok(bad(SLIVER, f64::INFINITY));
-        };
-        let xi = s.circumradius / self.spacing_at(centre, tag)?;
-        let rho = s.circumradius / s.shortest_edge;
-        Ok(if xi > self.params.size_factor {
-            bad(SIZE, xi)
-        } else if rho > self.params.rho0 {
-            bad(RATIO, rho)
-        } else if self.is_sliver(&s) {
-            bad(SLIVER, s.max_cos_dihedral)
+        }
+        let (centre, circumradius) = (a + offset, offset.length());
+        let xi = circumradius / self.spacing_at(centre, tag)?;
+        if xi > self.params.size_factor {
+            return Ok(bad(SIZE, xi));
+        }
+        let e = [
+            lu[0],
+            lu[1],
+            lu[2],
+            (c - b).length_squared(),
+            (d - b).length_squared(),
+            (d - c).length_squared(),
+        ];
+        let l2 = e[0].min(e[1]).min(e[2]).min(e[3]).min(e[4]).min(e[5]);
+        let rho = circumradius / l2.sqrt();
+        if rho > self.params.rho0 {
+            return Ok(bad(RATIO, rho));
+        }
+        let n = [
+            (d - b).cross(c - b).length_squared(),
+            vw.length_squared(),
+            wu.length_squared(),
+            uv.length_squared(),
+        ];
+        if self.screen.clears(det, e, l2, n) {
+            return Ok(None);
+        }
+        let (sigma, max_cos_dihedral) = sliver_measures(a, b, c, d, l2);
+        Ok(if self.is_sliver_by(sigma, max_cos_dihedral) {
+            bad(SLIVER, max_cos_dihedral)
         } else {
             None
         })
@@ -294,32 +326,33 @@ impl<'a> Refiner<'a> {
             }
             return self.split_boundary(bnd, r);
         }
-        // Draw candidates from the picking ball; keep the one with fewest small slivers.
-        let mut best: Option<(usize, f64, DVec3)> = None;
-        for _ in 0..self.params.max_tries.max(1) {
-            let p = centre + self.random_in_ball() * (self.params.delta * r);
-            let Some((n_small, worst)) = self.small_slivers(p, r, Some(bad.tet), None) else {
-                continue; // p would break the boundary
-            };
-            if best.is_none_or(|(n, w, _)| (n_small, -worst) < (n, -w)) {
-                best = Some((n_small, worst, p));
-            }
-            if n_small == 0 {
-                break;
+        // Draw candidates from the picking ball; keep the one with fewest small slivers among
+        // those that break no boundary.
+        let mut best = None;
+        // The centre is a point of the picking ball too, and its cavity is at hand (probed by
+        // the boundary check above, which it passed): the first candidate.
+        if !self.dom.dt.probed_cavity().1.is_empty() {
+            if let Some((n_small, worst)) = self.small_slivers(centre, r, None) {
+                best = Some(Candidate {
+                    n_small,
+                    worst,
+                    p: centre,
+                });
             }
         }
-        let p = match best {
-            Some((_, _, p)) => p,
-            None => centre,
-        };
-        if self.encroached_boundary(p, Some(bad.tet)).is_some() {
-            // Every draw would break the boundary and so does the centre (only near it).
-            if let Some(bnd) = self.encroached_boundary(centre, Some(bad.tet)) {
-                return self.split_boundary(bnd, r);
+        if best.is_none_or(|b| b.n_small > 0) {
+            for _ in 0..self.params.max_tries.max(1) {
+                let p = centre + self.random_in_ball() * (self.params.delta * r);
+                if self.try_candidate(p, r, Some(bad.tet), None, &mut best) {
+                    break;
+                }
             }
-            self.gave_up += 1;
-            return Ok(());
         }
+        // The chosen point breaks no boundary: a candidate was only kept after that check on
+        // its cavity, and the centre passed it above (nothing has changed since). When it was
+        // the last one probed (the usual case: its draw ended the search), the insertion
+        // reuses its cavity.
+        let p = best.map_or(centre, |b| b.p);
         self.dom
             .insert_point(p, super::domain::VertexKind::Volume, Some(bad.tet))?;
         self.settle_boundary()?;
@@ -329,11 +362,11 @@ impl<'a> Refiner<'a> {
     /// Inserts `p` (for bad tet `t` of size `r`) unless it would break the boundary; then the
     /// boundary element is split instead if it is not much smaller than `r`, else nothing.
     fn insert_volume_point(&mut self, p: DVec3, r: f64, t: u32) -> Result<(), MeshError> {
-        let DryRun::Cavity { removed, .. } = self.dom.dt.dry_run(p, Some(t)) else {
+        if let Probe::Duplicate(_) = self.dom.dt.probe(p, Some(t)) {
             self.gave_up += 1; // p is a vertex already (a flat tet's centroid can be)
             return Ok(());
-        };
-        if let Some(bnd) = self.boundary_in_cavity(p, &removed) {
+        }
+        if let Some(bnd) = self.boundary_in_cavity(p) {
             if !self.is_protected(bnd) && self.boundary_radius(bnd) >= 0.25 * r {
                 return self.split_boundary(bnd, r);
             }
@@ -363,40 +396,99 @@ impl<'a> Refiner<'a> {
         }
     }
 
-    /// Small slivers (circumradius <= b R, sigma < sigma0) inserting `p` would create, and the
-    /// smallest sigma among them; None if inserting `p` would cross the boundary (unless the
-    /// boundary element is `allowed`, the one being split).
-    fn small_slivers(
+    /// Probes candidate `p` for a bad element of circumradius `r` and makes it `best` if it
+    /// creates fewer small slivers (circumradius <= b r, sigma < sigma0 or a small dihedral
+    /// angle; ties: the larger smallest dihedral angle) and breaks no boundary (except the
+    /// element being split, `allowed`). Returns true when `p` creates no small sliver (the
+    /// search can stop; `p` is then the last point probed).
+    fn try_candidate(
         &mut self,
         p: DVec3,
         r: f64,
         hint: Option<u32>,
         allowed: Option<Boundary>,
-    ) -> Option<(usize, f64)> {
-        let DryRun::Cavity { removed, faces } = self.dom.dt.dry_run(p, hint) else {
-            return None;
-        };
-        if allowed.is_none() && self.boundary_in_cavity(p, &removed).is_some() {
-            return None;
+        best: &mut Option<Candidate>,
+    ) -> bool {
+        if let Probe::Duplicate(_) = self.dom.dt.probe(p, hint) {
+            return false;
         }
+        let Some((n_small, worst)) = self.small_slivers(p, r, best.map(|b| b.n_small)) else {
+            return false; // more small slivers than the best
+        };
+        if best.is_some_and(|b| (n_small, -worst) >= (b.n_small, -b.worst)) {
+            return false; // not better: whether it breaks the boundary does not matter
+        }
+        if allowed.is_none() && self.boundary_in_cavity(p).is_some() {
+            return false; // p would break the boundary
+        }
+        *best = Some(Candidate { n_small, worst, p });
+        n_small == 0
+    }
+
+    /// Small slivers (circumradius <= b R, sigma < sigma0 or a small dihedral angle) inserting
+    /// `p` would create, with the probed cavity of `p`, and the smallest 1 - cos(smallest
+    /// dihedral angle) among them; None as soon as there are more than `limit`.
+    fn small_slivers(&self, p: DVec3, r: f64, limit: Option<usize>) -> Option<(usize, f64)> {
         let mut n = 0;
         let mut worst = f64::INFINITY;
-        for f in faces {
-            if f.contains(&INFINITE) {
-                continue;
+        let max_r = self.params.b * r;
+        let faces = self.dom.dt.probed_cavity().1;
+        let points = self.dom.dt.points();
+        // The sliver screen first (most new tets pass it), over batches of faces laid out by
+        // coordinate so that it vectorizes; then the full measures for the others.
+        const BATCH: usize = 8;
+        for batch in faces.chunks(BATCH) {
+            // Lanes of hull faces and beyond the batch stay zero (flat: never cleared).
+            let mut q = [[0.0f64; BATCH]; 9];
+            let mut finite = [false; BATCH];
+            for (k, f) in batch.iter().enumerate() {
+                let v = f.vertices();
+                if v.contains(&INFINITE) {
+                    continue;
+                }
+                finite[k] = true;
+                for (j, &vj) in v.iter().enumerate() {
+                    let d = points[vj as usize] - p;
+                    q[3 * j][k] = d.x;
+                    q[3 * j + 1][k] = d.y;
+                    q[3 * j + 2][k] = d.z;
+                }
             }
-            let [x, y, z] = f.map(|v| self.dom.point(v));
-            let s = Shape::of(x, y, z, p);
-            if s.circumradius <= self.params.b * r && self.is_sliver(&s) {
-                n += 1;
-                worst = worst.min(s.max_cos_dihedral.mul_add(-1.0, 1.0));
+            let clear = self.screen.clears_batch(&q);
+            for (k, f) in batch.iter().enumerate() {
+                if finite[k] && !clear[k] {
+                    let [x, y, z] = f.vertices().map(|v| points[v as usize]);
+                    if let Some(w) = self.small_sliver(x, y, z, p, max_r) {
+                        n += 1;
+                        if limit.is_some_and(|m| n > m) {
+                            return None;
+                        }
+                        worst = worst.min(w);
+                    }
+                }
             }
         }
         Some((n, worst))
     }
 
-    fn is_sliver(&self, s: &Shape) -> bool {
-        s.sigma < self.params.sigma0 || s.max_cos_dihedral > self.cos_min_dihedral
+    /// For the new tet (x, y, z, p): 1 - cos(its smallest dihedral angle) if it is a sliver
+    /// with circumradius <= `max_r`.
+    #[inline]
+    fn small_sliver(&self, x: DVec3, y: DVec3, z: DVec3, p: DVec3, max_r: f64) -> Option<f64> {
+        {
+            let (sigma, max_cos) = sliver_measures(x, y, z, p, shortest_edge_sq(x, y, z, p));
+            if self.is_sliver_by(sigma, max_cos)
+                && circumsphere(x, y, z, p).map_or(f64::INFINITY, |s| s.1) <= max_r
+            {
+                return Some(max_cos.mul_add(-1.0, 1.0));
+            }
+        }
+        None
+    }
+
+    #[inline]
+    fn is_sliver_by(&self, sigma: f64, max_cos_dihedral: f64) -> bool {
+        sigma < self.params.sigma0 || max_cos_dihedral > self.cos_min_dihedral
     }
 
     /// The boundary element whose protection inserting `p` would violate: a subsegment or
@@ -404,85 +496,68 @@ impl<'a> Refiner<'a> {
     /// ball, or, when the cavity would cross the boundary (it holds an outside tet or would
     /// delete a subfacet), the subfacet it crosses.
     fn encroached_boundary(&mut self, p: DVec3, hint: Option<u32>) -> Option<Boundary> {
-        let DryRun::Cavity { removed, .. } = self.dom.dt.dry_run(p, hint) else {
+        if let Probe::Duplicate(_) = self.dom.dt.probe(p, hint) {
             return None;
-        };
-        self.boundary_in_cavity(p, &removed)
+        }
+        self.boundary_in_cavity(p)
     }
 
-    /// See [`Self::encroached_boundary`]; `removed` is the cavity of `p`.
-    fn boundary_in_cavity(&self, p: DVec3, removed: &[u32]) -> Option<Boundary> {
+    /// See [`Self::encroached_boundary`], for the probed cavity of `p`. Looks at the cavity
+    /// and the ring of tets around it (an equatorial ball can hold p while the (obtuse) tet on
+    /// its inner side does not have p in its circumsphere); of the encroached elements it
+    /// names the smallest subsegment (by key), else the smallest subfacet.
+    fn boundary_in_cavity(&self, p: DVec3) -> Option<Boundary> {
         let dom = &*self.dom;
-        let mut crosses = false;
-        let mut crossed: Option<Boundary> = None;
-        let mut segs = vec![];
-        let mut facets = vec![];
-        // The cavity and the ring of tets around it: an equatorial ball can hold p while the
-        // (obtuse) tet on its inner side does not have p in its circumsphere.
-        let mut sorted = removed.to_vec();
-        sorted.sort_unstable();
-        let in_removed = |t: u32| sorted.binary_search(&t).is_ok();
-        // (Ring tets may repeat: harmless, the checks below are idempotent.)
-        let mut near: Vec<u32> = removed.to_vec();
-        for &t in removed {
-            for n in dom.dt.neighbors(t) {
-                if !in_removed(n) {
-                    near.push(n);
-                }
-            }
+        let (removed, faces) = dom.dt.probed_cavity();
+        // Every vertex of a cavity tet is on the cavity's boundary, and a ring tet adds one
+        // vertex to a boundary face: if no boundary face has a vertex on the domain boundary,
+        // no cavity or ring tet has two, so the scan below would find no subsegment or
+        // subfacet (and, crossing or not, name none).
+        let on_boundary = |v: u32| v == INFINITE || dom.kind[v as usize] != VertexKind::Volume;
+        if !faces
+            .iter()
+            .any(|f| f.vertices().into_iter().any(on_boundary))
+        {
+            return None;
         }
-        for (k, &t) in near.iter().enumerate() {
-            let in_cavity = k < removed.len();
+        let mut scan = BoundaryScan {
+            p,
+            removed,
+            seg: None,
+            facet: None,
+            any_facet: None,
+            crossed: None,
+        };
+        let mut crosses = false;
+        for &t in removed {
             if !dom.dt.is_finite(t) || dom.dt.tag(t) == 0 {
-                crosses |= in_cavity;
+                crosses = true;
                 continue;
             }
-            let v = dom.dt.tet(t);
-            let on_boundary = v.map(|x| dom.kind[x as usize] != VertexKind::Volume);
-            if on_boundary.iter().filter(|&&b| b).count() < 2 {
-                continue; // no subsegment or subfacet among its edges and faces
+            scan.tet(dom, t, true);
+        }
+        // The ring: the tets across the cavity's boundary faces (a tet may come up more than
+        // once; the checks are idempotent). One whose face has no boundary vertex has at most
+        // one (its apex).
+        for f in faces {
+            if !f.vertices().into_iter().any(on_boundary) {
+                continue;
             }
-            for i in 0..4 {
-                for j in i + 1..4 {
-                    let k = seg_key(v[i], v[j]);
-                    if on_boundary[i] && on_boundary[j] && dom.subsegs.contains_key(&k) {
-                        segs.push(k);
-                    }
-                }
-                if on_boundary[i] {
-                    continue; // face i is opposite vertex i: it holds the other three
-                }
-                let f = FACE[i].map(|l| v[l]);
-                if let Some(&fi) = dom.subfacets.get(&tri_key(f)) {
-                    facets.push((fi, tri_key(f)));
-                    let n = dom.dt.neighbors(t)[i];
-                    if in_cavity && in_removed(n) {
-                        crosses = true;
-                        crossed = Some(Boundary::Facet(fi, tri_key(f)));
-                    }
-                }
+            let t = f.outer_tet();
+            if dom.dt.is_finite(t) && dom.dt.tag(t) != 0 {
+                scan.tet(dom, t, false);
             }
         }
-        segs.sort_unstable();
-        segs.dedup();
-        for &(a, b) in &segs {
-            let (c, r) = diametric_ball(dom.point(a), dom.point(b));
-            if p.distance_squared(c) <= r * r {
-                return Some(Boundary::Segment(a, b));
-            }
+        if let Some((a, b)) = scan.seg {
+            return Some(Boundary::Segment(a, b));
         }
-        facets.sort_unstable();
-        facets.dedup();
-        for &(fi, t) in &facets {
-            let [x, y, z] = t.map(|v| dom.point(v));
-            if let Some((c, r)) = equatorial_ball(x, y, z) {
-                if p.distance_squared(c) <= r * r {
-                    return Some(Boundary::Facet(fi, t));
-                }
-            }
+        if let Some((fi, t)) = scan.facet {
+            return Some(Boundary::Facet(fi, t));
         }
-        if crosses {
-            return crossed.or_else(|| facets.first().map(|&(fi, t)| Boundary::Facet(fi, t)));
+        if crosses || scan.crossed.is_some() {
+            return scan
+                .crossed
+                .or_else(|| scan.any_facet.map(|(fi, t)| Boundary::Facet(fi, t)));
         }
         None
     }
@@ -555,9 +630,18 @@ impl<'a> Refiner<'a> {
                     self.gave_up += 1;
                     return Ok(());
                 };
-                let cf = self.dom.snap_to_facet_plane(f, cf);
-                let enc = self.dom.facet_subsegments_encroached_by(f, cf);
-                if let Some(&(a, c)) = enc.first() {
+                // The facet's plane snap and subsegment balls, once for the centre and all
+                // the draws (the same tests as snap_to_facet_plane and
+                // facet_subsegments_encroached_by, which walk the whole facet).
+                let snap = PlaneSnap::of(self.dom, f);
+                let balls = subsegment_balls(self.dom, f);
+                let cf = snap.apply(cf);
+                let enc = balls
+                    .iter()
+                    .filter(|b| cf.distance_squared(b.centre) <= b.r2)
+                    .map(|b| b.key)
+                    .min();
+                if let Some((a, c)) = enc {
                     self.split_segment_picked(a, c)?;
                 } else if self.dom.facets[f as usize].locate(cf).is_none() {
                     self.gave_up += 1;
@@ -567,32 +651,32 @@ impl<'a> Refiner<'a> {
                     let n = (y - x).cross(z - x).normalize();
                     let u = (y - x).normalize();
                     let w = n.cross(u);
-                    let mut best: Option<(usize, f64, DVec3)> = None;
-                    for _ in 0..self.params.max_tries.max(1) {
+                    // The centre first (it passed the facet checks above), then random draws.
+                    let mut best = None;
+                    let hint = self.dom.dt.vertex_tet(t[0]);
+                    let centre_ok = self.try_candidate(cf, rf, hint, Some(b), &mut best);
+                    for _ in 0..if centre_ok {
+                        0
+                    } else {
+                        self.params.max_tries.max(1)
+                    } {
                         let (s, th) = (
                             self.rng.gen::<f64>().sqrt(),
                             self.rng.gen::<f64>() * std::f64::consts::TAU,
                         );
                         let p = cf + (u * th.cos() + w * th.sin()) * (s * self.params.delta * rf);
-                        let p = self.dom.snap_to_facet_plane(f, p);
+                        let p = snap.apply(p);
                         if self.dom.facets[f as usize].locate(p).is_none()
-                            || !self.dom.facet_subsegments_encroached_by(f, p).is_empty()
+                            || balls.iter().any(|b| p.distance_squared(b.centre) <= b.r2)
                         {
                             continue;
                         }
                         let hint = self.dom.dt.vertex_tet(t[0]);
-                        let Some((n_small, worst)) = self.small_slivers(p, rf, hint, Some(b))
-                        else {
-                            continue;
-                        };
-                        if best.is_none_or(|(n, w, _)| (n_small, -worst) < (n, -w)) {
-                            best = Some((n_small, worst, p));
-                        }
-                        if n_small == 0 {
+                        if self.try_candidate(p, rf, hint, Some(b), &mut best) {
                             break;
                         }
                     }
-                    let p = best.map_or(cf, |(_, _, p)| p);
+                    let p = best.map_or(cf, |c| c.p);
                     let hint = self.dom.dt.vertex_tet(t[0]);
                     self.dom.split_in_facet(f, p, hint)?;
                 }
@@ -611,24 +695,17 @@ impl<'a> Refiner<'a> {
             self.dom.segment_split_point(a, c)
         } else {
             let r = 0.5 * pa.distance(pc);
-            let mut best: Option<(usize, f64, DVec3)> = None;
+            let mut best = None;
             for _ in 0..self.params.max_tries.max(1) {
                 let t = 0.5 + self.rng.gen_range(-0.5..0.5) * self.params.delta;
                 let p = pa + (pc - pa) * t;
                 let hint = self.dom.dt.vertex_tet(a);
-                let Some((n_small, worst)) =
-                    self.small_slivers(p, r, hint, Some(Boundary::Segment(a, c)))
-                else {
-                    continue;
-                };
-                if best.is_none_or(|(n, w, _)| (n_small, -worst) < (n, -w)) {
-                    best = Some((n_small, worst, p));
-                }
-                if n_small == 0 {
+                let allowed = Some(Boundary::Segment(a, c));
+                if self.try_candidate(p, r, hint, allowed, &mut best) {
                     break;
                 }
             }
-            best.map_or(pa + (pc - pa) * 0.5, |(_, _, p)| p)
+            best.map_or(pa + (pc - pa) * 0.5, |c| c.p)
         };
         self.dom.split_subsegment(a, c, p)?;
         Ok(())
@@ -669,8 +746,10 @@ fn longest_edge(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
     .sqrt()
 }
 
-/// The measures refinement decides on, computed without trigonometry.
+/// The measures refinement decides on, computed without trigonometry (the refiner computes
+/// them piecemeal, with the same expressions; all of them are checked by a test).
 #[derive(Debug, Clone, Copy)]
+#[cfg_attr(not(test), allow(dead_code))]
 struct Shape {
     circumcenter: Option<DVec3>,
     circumradius: f64,
@@ -683,42 +762,315 @@ struct Shape {
 impl Shape {
     #[inline]
     fn of(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Shape {
-        let sphere = crate::geom::circumsphere(a, b, c, d);
-        let l2 = [
-            a.distance_squared(b),
-            a.distance_squared(c),
-            a.distance_squared(d),
-            b.distance_squared(c),
-            b.distance_squared(d),
-            c.distance_squared(d),
-        ]
-        .into_iter()
-        .fold(f64::INFINITY, f64::min);
-        let shortest_edge = l2.sqrt();
-        let volume = (b - a).dot((c - a).cross(d - a)).abs() / 6.0;
-        // Face normals, all outward or all inward (the sign cancels): the dihedral angle at an
-        // edge is pi minus the angle between its two faces' normals, so its cosine is
-        // -n_i . n_j / (|n_i| |n_j|).
-        let n = [
-            (d - b).cross(c - b),
-            (c - a).cross(d - a),
-            (d - a).cross(b - a),
-            (b - a).cross(c - a),
-        ];
-        let len = n.map(|v| v.length());
-        let mut max_cos = -1.0f64;
-        for i in 0..4 {
-            for j in i + 1..4 {
-                let cos = -n[i].dot(n[j]) / (len[i] * len[j]);
-                max_cos = max_cos.max(cos);
-            }
-        }
+        let sphere = circumsphere(a, b, c, d);
+        let l2 = shortest_edge_sq(a, b, c, d);
+        let (sigma, max_cos_dihedral) = sliver_measures(a, b, c, d, l2);
         Shape {
             circumcenter: sphere.map(|s| s.0),
             circumradius: sphere.map_or(f64::INFINITY, |s| s.1),
-            shortest_edge,
-            sigma: volume / (l2 * shortest_edge),
-            max_cos_dihedral: if max_cos.is_nan() { 1.0 } else { max_cos },
+            shortest_edge: l2.sqrt(),
+            sigma,
+            max_cos_dihedral,
+        }
+    }
+}
+
+/// Squared length of the shortest edge.
+#[inline]
+fn shortest_edge_sq(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
+    [
+        a.distance_squared(b),
+        a.distance_squared(c),
+        a.distance_squared(d),
+        b.distance_squared(c),
+        b.distance_squared(d),
+        c.distance_squared(d),
+    ]
+    .into_iter()
+    .fold(f64::INFINITY, f64::min)
+}
+
+/// sigma = V / L^3 and the cosine of the smallest dihedral angle, given L^2 = `l2`.
+#[inline]
+fn sliver_measures(a: DVec3, b: DVec3, c: DVec3, d: DVec3, l2: f64) -> (f64, f64) {
+    let volume = (b - a).dot((c - a).cross(d - a)).abs() / 6.0;
+    // Face normals, all outward or all inward (the sign cancels): the dihedral angle at an
+    // edge is pi minus the angle between its two faces' normals, so its cosine is
+    // -n_i . n_j / (|n_i| |n_j|).
+    let n = [
+        (d - b).cross(c - b),
+        (c - a).cross(d - a),
+        (d - a).cross(b - a),
+        (b - a).cross(c - a),
+    ];
+    let len = n.map(|v| v.length());
+    let mut max_cos = -1.0f64;
+    for i in 0..4 {
+        for j in i + 1..4 {
+            let cos = -n[i].dot(n[j]) / (len[i] * len[j]);
+            max_cos = max_cos.max(cos);
+        }
+    }
+    let sigma = volume / (l2 * l2.sqrt());
+    (sigma, if max_cos.is_nan() { 1.0 } else { max_cos })
+}
+
+/// [`Domain::snap_to_facet_plane`] for one facet, its vertices looked at once: the
+/// coordinates shared by all of them.
+struct PlaneSnap([Option<f64>; 3]);
+
+impl PlaneSnap {
+    fn of(dom: &Domain, f: u32) -> PlaneSnap {
+        let mut verts = dom.facets[f as usize].vertices();
+        let mut axes = [None; 3];
+        if let Some(v0) = verts.next() {
+            let q0 = dom.point(v0);
+            axes = [Some(q0.x), Some(q0.y), Some(q0.z)];
+            for v in verts {
+                let q = dom.point(v);
+                for (axis, a) in axes.iter_mut().enumerate() {
+                    if a.is_some_and(|c| q[axis] != c) {
+                        *a = None;
+                    }
+                }
+            }
+        }
+        PlaneSnap(axes)
+    }
+
+    fn apply(&self, mut p: DVec3) -> DVec3 {
+        for (axis, a) in self.0.iter().enumerate() {
+            if let Some(c) = a {
+                p[axis] = *c;
+            }
+        }
+        p
+    }
+}
+
+/// A subsegment's closed diametric ball, slightly inflated, as
+/// [`Domain::facet_subsegments_encroached_by`] tests it.
+struct SubsegmentBall {
+    key: (u32, u32),
+    centre: DVec3,
+    r2: f64,
+}
+
+/// The balls of facet `f`'s subsegments.
+fn subsegment_balls(dom: &Domain, f: u32) -> Vec<SubsegmentBall> {
+    dom.facets[f as usize]
+        .constrained_edges()
+        .into_iter()
+        .map(|[x, y]| {
+            let (centre, r) = diametric_ball(dom.point(x), dom.point(y));
+            SubsegmentBall {
+                key: seg_key(x, y),
+                centre,
+                r2: r * r * (1.0 + 1e-9),
+            }
+        })
+        .collect()
+}
+
+/// A cheap sufficient condition for "not a sliver" (sigma >= sigma0 and every dihedral angle
+/// within [min_dihedral, 180 - min_dihedral]), in squares only: no square root, no division.
+/// It holds with a relative margin, so that [`sliver_measures`] would surely find the tet
+/// good too; the tets it does not clear (slivers and near misses) get the full measures.
+#[derive(Debug, Clone, Copy)]
+struct SliverScreen {
+    /// 36 sigma0^2 (1 + MARGIN): sigma >= sigma0 iff det^2 >= 36 sigma0^2 L^6.
+    sigma: f64,
+    /// sin^2(min_dihedral) (1 + MARGIN): the dihedral angle at edge e, between the faces
+    /// with normals (cross products) n_r and n_s, has sin = |det| |e| / (|n_r| |n_s|).
+    dihedral: f64,
+}
+
+impl SliverScreen {
+    const MARGIN: f64 = 1e-6;
+
+    fn new(params: &Params) -> Self {
+        let s0 = params.min_dihedral.to_radians().sin();
+        SliverScreen {
+            sigma: 36.0 * params.sigma0 * params.sigma0 * (1.0 + Self::MARGIN),
+            dihedral: s0 * s0 * (1.0 + Self::MARGIN),
+        }
+    }
+
+    /// The screen for one tet, as `classify` runs it (through [`Self::clears`]).
+    #[cfg(test)]
+    fn clearly_not_sliver(&self, a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> bool {
+        let (u, v, w) = (b - a, c - a, d - a);
+        let det = u.dot(v.cross(w));
+        let e = [
+            u.length_squared(),
+            v.length_squared(),
+            w.length_squared(),
+            (c - b).length_squared(),
+            (d - b).length_squared(),
+            (d - c).length_squared(),
+        ];
+        let l2 = e[0].min(e[1]).min(e[2]).min(e[3]).min(e[4]).min(e[5]);
+        if det * det <= self.sigma * (l2 * l2 * l2) {
+            return false;
+        }
+        let n = [
+            (d - b).cross(c - b).length_squared(),
+            v.cross(w).length_squared(),
+            w.cross(u).length_squared(),
+            u.cross(v).length_squared(),
+        ];
+        self.clears(det, e, l2, n)
+    }
+
+    /// The screen for a batch of tets (p, x_k, y_k, z_k) given by the coordinates relative to
+    /// p: `q[0..3]` = x - p, `q[3..6]` = y - p, `q[6..9]` = z - p (lane k: tet k). Branch-free
+    /// over the lanes, so that it vectorizes.
+    #[inline]
+    fn clears_batch<const N: usize>(&self, q: &[[f64; N]; 9]) -> [bool; N] {
+        let mut out = [false; N];
+        for (k, o) in out.iter_mut().enumerate() {
+            let (ux, uy, uz) = (q[0][k], q[1][k], q[2][k]);
+            let (vx, vy, vz) = (q[3][k], q[4][k], q[5][k]);
+            let (wx, wy, wz) = (q[6][k], q[7][k], q[8][k]);
+            // Face edges y - x, z - x, z - y.
+            let (ax, ay, az) = (vx - ux, vy - uy, vz - uz);
+            let (bx, by, bz) = (wx - ux, wy - uy, wz - uz);
+            let (cx, cy, cz) = (wx - vx, wy - vy, wz - vz);
+            let e = [
+                ux * ux + uy * uy + uz * uz,
+                vx * vx + vy * vy + vz * vz,
+                wx * wx + wy * wy + wz * wz,
+                ax * ax + ay * ay + az * az,
+                bx * bx + by * by + bz * bz,
+                cx * cx + cy * cy + cz * cz,
+            ];
+            let m = |a: f64, b: f64| if b < a { b } else { a };
+            let l2 = m(m(m(e[0], e[1]), m(e[2], e[3])), m(e[4], e[5]));
+            // Normals of the faces opposite x (p, y, z), y, z and p (x, y, z).
+            let (nxx, nxy, nxz) = (vy * wz - vz * wy, vz * wx - vx * wz, vx * wy - vy * wx);
+            let (nyx, nyy, nyz) = (wy * uz - wz * uy, wz * ux - wx * uz, wx * uy - wy * ux);
+            let (nzx, nzy, nzz) = (uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx);
+            let (npx, npy, npz) = (ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx);
+            let det = ux * nxx + uy * nxy + uz * nxz;
+            let n = [
+                nxx * nxx + nxy * nxy + nxz * nxz,
+                nyx * nyx + nyy * nyy + nyz * nyz,
+                nzx * nzx + nzy * nzy + nzz * nzz,
+                npx * npx + npy * npy + npz * npz,
+            ];
+            let det2 = det * det;
+            let kd = self.dihedral;
+            // Edges px, py, pz, xy, xz, yz and the faces meeting there (opposite the other
+            // two vertices).
+            *o = (det2 > self.sigma * (l2 * l2 * l2))
+                & (det2 * e[0] >= kd * (n[1] * n[2]))
+                & (det2 * e[1] >= kd * (n[0] * n[2]))
+                & (det2 * e[2] >= kd * (n[0] * n[1]))
+                & (det2 * e[3] >= kd * (n[2] * n[3]))
+                & (det2 * e[4] >= kd * (n[1] * n[3]))
+                & (det2 * e[5] >= kd * (n[0] * n[3]));
+        }
+        out
+    }
+
+    /// The screen from the tet's pieces: `det` = det[b-a, c-a, d-a] (up to a relative error
+    /// far below the margin), the squared edge lengths `e` (ab, ac, ad, bc, bd, cd), the
+    /// shortest `l2` and the squared normal lengths `n` of the faces opposite a, b, c, d.
+    #[inline]
+    fn clears(&self, det: f64, e: [f64; 6], l2: f64, n: [f64; 4]) -> bool {
+        let det2 = det * det;
+        if det2 <= self.sigma * (l2 * l2 * l2) {
+            return false; // (a flat tet is never cleared, even with sigma0 = 0)
+        }
+        // Edges ab, ac, ad, bc, bd, cd and the faces meeting there (opposite the other two).
+        let k = self.dihedral;
+        det2 * e[0] >= k * (n[2] * n[3])
+            && det2 * e[1] >= k * (n[1] * n[3])
+            && det2 * e[2] >= k * (n[1] * n[2])
+            && det2 * e[3] >= k * (n[0] * n[3])
+            && det2 * e[4] >= k * (n[0] * n[2])
+            && det2 * e[5] >= k * (n[0] * n[1])
+    }
+}
+
+/// A candidate point and the small slivers inserting it would create.
+#[derive(Debug, Clone, Copy)]
+struct Candidate {
+    n_small: usize,
+    /// Smallest 1 - cos(smallest dihedral angle) among them.
+    worst: f64,
+    p: DVec3,
+}
+
+/// The boundary elements among a cavity's and its ring's edges and faces that a point
+/// encroaches or whose protection the cavity would break (see
+/// [`Refiner::boundary_in_cavity`]).
+struct BoundaryScan<'c> {
+    p: DVec3,
+    /// The cavity tets.
+    removed: &'c [u32],
+    /// Smallest encroached subsegment.
+    seg: Option<(u32, u32)>,
+    /// Smallest encroached subfacet.
+    facet: Option<(u32, [u32; 3])>,
+    /// Smallest subfacet seen.
+    any_facet: Option<(u32, [u32; 3])>,
+    /// The last subfacet seen with the cavity on both sides.
+    crossed: Option<Boundary>,
+}
+
+impl BoundaryScan<'_> {
+    /// The edges and faces of tet `t` (finite, inside the domain; `in_cavity` if it is a
+    /// cavity tet).
+    #[inline]
+    fn tet(&mut self, dom: &Domain, t: u32, in_cavity: bool) {
+        let v = dom.dt.tet(t);
+        let kind = v.map(|x| dom.kind[x as usize]);
+        let on_boundary = kind.map(|k| k != VertexKind::Volume);
+        let n_boundary = on_boundary.iter().filter(|&&b| b).count();
+        if n_boundary < 2 {
+            return; // no subsegment or subfacet among its edges and faces
+        }
+        // Subsegments join input and segment vertices only.
+        let on_segment = kind.map(|k| matches!(k, VertexKind::Input | VertexKind::Segment(_)));
+        for i in 0..4 {
+            for j in i + 1..4 {
+                if !(on_segment[i] && on_segment[j]) {
+                    continue;
+                }
+                let k = seg_key(v[i], v[j]);
+                if self.seg.is_some_and(|s| s <= k) || !dom.subsegs.contains_key(&k) {
+                    continue; // (a smaller one is encroached already)
+                }
+                let (c, r) = diametric_ball(dom.point(k.0), dom.point(k.1));
+                if self.p.distance_squared(c) <= r * r {
+                    self.seg = Some(k);
+                }
+            }
+            // Face i is opposite vertex i: it holds the other three, which must all lie on
+            // the boundary for it to be a subfacet.
+            if n_boundary < 3 || (n_boundary == 3 && on_boundary[i]) {
+                continue;
+            }
+            let f = tri_key(FACE[i].map(|l| v[l]));
+            let Some(&fi) = dom.subfacets.get(&f) else {
+                continue;
+            };
+            let key = (fi, f);
+            if self.any_facet.is_none_or(|a| key < a) {
+                self.any_facet = Some(key);
+            }
+            if in_cavity && self.removed.contains(&dom.dt.neighbors(t)[i]) {
+                self.crossed = Some(Boundary::Facet(fi, f));
+            }
+            if self.seg.is_none() && self.facet.is_none_or(|e| key < e) {
+                let [x, y, z] = f.map(|v| dom.point(v));
+                if let Some((c, r)) = equatorial_ball(x, y, z) {
+                    if self.p.distance_squared(c) <= r * r {
+                        self.facet = Some(key);
+                    }
+                }
+            }
         }
     }
 }
@@ -727,6 +1079,58 @@ impl Shape {
 mod tests {
     use super::*;
     use crate::geom::TetQuality;
+
+    #[test]
+    fn sliver_screen_clears_only_good_tets() {
+        let params = Params::default();
+        let screen = SliverScreen::new(&params);
+        let cos_min = params.min_dihedral.to_radians().cos();
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let mut cleared = 0;
+        let mut flagged = 0;
+        for k in 0..200_000 {
+            let mut p = [DVec3::ZERO; 4];
+            for q in p.iter_mut() {
+                *q = DVec3::new(rng.gen(), rng.gen(), rng.gen());
+            }
+            if k % 2 == 1 {
+                // Near-slivers and near-flat tets: squash the fourth vertex towards a plane.
+                let t: f64 = rng.gen::<f64>().powi(4);
+                p[3] = p[3].lerp((p[0] + p[1] + p[2]) / 3.0 + (p[3] - p[0]) * 0.01, 1.0 - t);
+            }
+            let s = Shape::of(p[0], p[1], p[2], p[3]);
+            let bad = s.sigma < params.sigma0 || s.max_cos_dihedral > cos_min;
+            // The batch form, as small_slivers runs it: (p[3], p[0], p[1], p[2]) relative to
+            // p[3], in lane k % 4 of a batch of 4.
+            let mut q = [[0.0; 4]; 9];
+            for j in 0..3 {
+                let d = p[j] - p[3];
+                q[3 * j][k % 4] = d.x;
+                q[3 * j + 1][k % 4] = d.y;
+                q[3 * j + 2][k % 4] = d.z;
+            }
+            let batch = screen.clears_batch(&q);
+            assert!(!batch[(k + 1) % 4], "an empty lane is cleared");
+            let single = screen.clearly_not_sliver(p[0], p[1], p[2], p[3]);
+            for clear in [single, batch[k % 4]] {
+                if clear {
+                    assert!(
+                        !bad,
+                        "{p:?}: cleared, sigma {} cos {}",
+                        s.sigma, s.max_cos_dihedral
+                    );
+                    cleared += 1;
+                } else if !bad {
+                    flagged += 1;
+                }
+            }
+        }
+        // It clears nearly every good tet (not those with a dihedral angle near 180 degrees).
+        assert!(
+            cleared > 100_000 && flagged < cleared / 100,
+            "{cleared} {flagged}"
+        );
+    }
 
     #[test]
     fn shape_agrees_with_tet_quality() {
@@ -756,6 +1160,7 @@ mod tests {
                 assert!((s.max_cos_dihedral - q.min_dihedral.to_radians().cos()).abs() < 1e-12);
                 assert!((s.sigma - q.sigma).abs() < 1e-12 * q.sigma.max(1.0));
                 assert!((s.circumradius - q.circumradius).abs() < 1e-12);
+                assert!((s.shortest_edge - q.shortest_edge).abs() < 1e-12);
             }
         }
     }
