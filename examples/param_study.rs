@@ -17,6 +17,12 @@ fn main() {
         "poly/lshape.poly",
         "poly/two_materials.poly",
         "poly/drilled_block.poly",
+        "poly/box_with_cavity.poly",
+        "poly/stairs.poly",
+        "poly/thin_plate.poly",
+        "poly/tetgen_example.poly",
+        "off/cube.off",
+        "off/cross.off",
     ];
     // (rho0, sigma0, min_dihedral, delta, b)
     let combos: &[(f64, f64, f64, f64, f64)] = &[
@@ -29,6 +35,7 @@ fn main() {
         (2.0, 0.02, 20.0, 0.3, 4.0),
         (2.0, 0.02, 25.0, 0.3, 4.0),
         (2.0, 0.02, 28.0, 0.3, 4.0),
+        (2.0, 0.02, 30.0, 0.3, 4.0),
         (1.5, 0.02, 15.0, 0.3, 4.0),
         (2.0, 0.02, 20.0, 0.1, 4.0),
         (2.0, 0.02, 20.0, 0.5, 4.0),
@@ -48,7 +55,7 @@ fn main() {
                 min_dihedral,
                 delta,
                 b,
-                max_vertices: 400_000,
+                max_vertices: 150_000,
                 ..Params::default()
             };
             let h = ConstantSpacing(size);
