@@ -359,15 +359,18 @@ impl<'a> Refiner<'a> {
         self.push_recent()
     }
 
-    /// Inserts `p` (for bad tet `t` of size `r`) unless it would break the boundary; then the
-    /// boundary element is split instead if it is not much smaller than `r`, else nothing.
+    /// Inserts `p` (for size-bad tet `t` of size `r`) unless it would break the boundary; then
+    /// the boundary element is split instead if it is not much smaller than `r`, else nothing.
     fn insert_volume_point(&mut self, p: DVec3, r: f64, t: u32) -> Result<(), MeshError> {
         if let Probe::Duplicate(_) = self.dom.dt.probe(p, Some(t)) {
             self.gave_up += 1; // p is a vertex already (a flat tet's centroid can be)
             return Ok(());
         }
         if let Some(bnd) = self.boundary_in_cavity(p) {
-            if !self.is_protected(bnd) && self.boundary_radius(bnd) >= 0.25 * r {
+            // Only size refinement comes here: the boundary element is split even next to a
+            // small angle (such splits stop once the elements are a fraction of f, unlike
+            // splits for shape, which can go on without end).
+            if self.boundary_radius(bnd) >= 0.25 * r {
                 return self.split_boundary(bnd, r);
             }
             if self.is_protected(bnd) {
