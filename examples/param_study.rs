@@ -47,7 +47,9 @@ fn main() {
     println!("| model | rho0 | sigma0 | min dihedral bound | delta | b | vertices | tets | max rho | min sigma | min dihedral | complete | seconds |");
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for rel in inputs {
-        let input = read_plc(&models.join(rel), &ReadOptions::default()).expect("read");
+        // As the CLI does: coplanar triangles of a surface become polygon facets.
+        let merge_coplanar = rel.ends_with(".off");
+        let input = read_plc(&models.join(rel), &ReadOptions { merge_coplanar }).expect("read");
         for &(rho0, sigma0, min_dihedral, delta, b) in combos {
             let params = Params {
                 rho0,
