@@ -76,3 +76,18 @@ fn big_acute_off_models_conform() {
         conforming(rel, None);
     }
 }
+
+/// The surface check can fail: a boundary triangle given another facet's marker is found.
+#[test]
+fn surface_check_detects_a_triangle_off_its_facet() {
+    let input = read_model("off/cube.off"); // one marker per face (cube.poly has one in all)
+    let mut m = conforming("off/cube.off", Some(8.0));
+    let other = *m
+        .boundary_markers
+        .iter()
+        .find(|&&mk| mk != m.boundary_markers[0])
+        .expect("two markers");
+    m.boundary_markers[0] = other;
+    let r = std::panic::catch_unwind(|| check_on_input_surface("cube", &input, &m));
+    assert!(r.is_err(), "a triangle with a wrong marker passed");
+}

@@ -155,18 +155,16 @@ impl<'a> Refiner<'a> {
                 verts,
             })
         };
-        if verts.iter().any(|&v| self.dom.near_acute(v)) {
-            // Next to a small input angle only size is enforced, and by the longest edge: the
-            // tets there may stay flat, and a flat tet's circumradius says nothing about its size.
+        let near = verts.iter().any(|&v| self.dom.near_acute(v));
+        if near {
+            // Next to a small input angle size is measured by the longest edge: the tets there
+            // may stay flat, and a flat tet's circumradius says nothing about its size.
             let centroid = (a + b + c + d) * 0.25;
             let xi =
                 longest_edge(a, b, c, d) / (EDGE_PER_RADIUS * self.spacing_at(centroid, tag)?);
-            return Ok((xi > self.params.size_factor).then_some(Bad {
-                class: SIZE,
-                badness: xi,
-                tet: t,
-                verts,
-            }));
+            if xi > self.params.size_factor {
+                return Ok(bad(SIZE, xi));
+            }
         }
         // Shape::of's measures, each computed only when the tests before it pass, sharing the
         // edge vectors and cross products: the circumsphere exactly as geom::circumsphere
@@ -180,9 +178,11 @@ impl<'a> Refiner<'a> {
             return Ok(bad(SLIVER, f64::INFINITY));
         }
         let (centre, circumradius) = (a + offset, offset.length());
-        let xi = circumradius / self.spacing_at(centre, tag)?;
-        if xi > self.params.size_factor {
-            return Ok(bad(SIZE, xi));
+        if !near {
+            let xi = circumradius / self.spacing_at(centre, tag)?;
+            if xi > self.params.size_factor {
+                return Ok(bad(SIZE, xi));
+            }
         }
         let e = [
             lu[0],
@@ -270,14 +270,9 @@ impl<'a> Refiner<'a> {
     }
 
     fn refine_tet(&mut self, bad: Bad) -> Result<(), MeshError> {
-        // Shape bounds are not enforced next to acute input angles (the paper assumes none;
-        // enforcing them there splits the boundary without end). Size still is.
-        if bad.class != SIZE && bad.verts.iter().any(|&v| self.dom.near_acute(v)) {
-            self.gave_up += 1;
-            return Ok(());
-        }
+        let near = bad.verts.iter().any(|&v| self.dom.near_acute(v));
         let [a, b, c, d] = self.dom.dt.tet_points(bad.tet);
-        if bad.verts.iter().any(|&v| self.dom.near_acute(v)) {
+        if near && bad.class == SIZE {
             // Size-bad next to a small angle (see `classify`): split at the centroid, which
             // lies in the tet even when it is flat and its circumcentre is far away.
             let centroid = (a + b + c + d) * 0.25;
@@ -303,7 +298,29 @@ impl<'a> Refiner<'a> {
             }
             return Ok(());
         }
-        if let Some(bnd) = self.encroached_boundary(centre, Some(bad.tet)) {
+        // Next to a small angle shape is improved only by the circumcentre, and only when it
+        // breaks no boundary: splitting the boundary there for shape would never end (the
+        // paper assumes no small angles). Only tets whose circumcentre is close (a sliver's,
+        // not a cap's) are tried: a far centre has a huge cavity that always reaches the
+        // boundary. Random draws from the picking ball as well cost 3-10x the time there for
+        // 10-30% fewer bad tets (measured on the .off models). A tet the centre does not fix
+        // is left, counted as within the angle's influence.
+        if near && r > longest_edge(a, b, c, d) {
+            return self.leave_near_small_angle(bad);
+        }
+        let centre_breaks = self.encroached_boundary(centre, Some(bad.tet));
+        if near {
+            // An empty probed cavity: the centre is a vertex already.
+            if centre_breaks.is_some() || self.dom.dt.probed_cavity().1.is_empty() {
+                return self.leave_near_small_angle(bad);
+            }
+            // The insertion reuses the centre's probed cavity.
+            self.dom
+                .insert_point(centre, super::domain::VertexKind::Volume, Some(bad.tet))?;
+            self.settle_boundary()?;
+            return self.push_recent();
+        }
+        if let Some(bnd) = centre_breaks {
             if self.is_protected(bnd) {
                 self.gave_up += 1;
                 self.blocked_by_small_angle.insert(sorted4(bad.verts));
@@ -384,6 +401,13 @@ impl<'a> Refiner<'a> {
             .insert_point(p, super::domain::VertexKind::Volume, Some(t))?;
         self.settle_boundary()?;
         self.push_recent()
+    }
+
+    /// Leaves bad tet `bad` as it is: it is within a small input angle's influence.
+    fn leave_near_small_angle(&mut self, bad: Bad) -> Result<(), MeshError> {
+        self.gave_up += 1;
+        self.blocked_by_small_angle.insert(sorted4(bad.verts));
+        Ok(())
     }
 
     fn random_in_ball(&mut self) -> DVec3 {

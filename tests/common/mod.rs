@@ -147,6 +147,48 @@ pub fn check_boundary_faces_are_tet_faces(m: &TetMesh) {
     }
 }
 
+/// No boundary triangle lies off the input surface: each one lies on an input facet with its
+/// marker (its vertices in the facet's plane, its centroid inside the facet's triangulated
+/// polygon), up to a tolerance relative to the model's size.
+pub fn check_on_input_surface(rel: &str, input: &PlcInput, m: &TetMesh) {
+    let plc = slivermesh::plc::validate(input).expect("valid input");
+    let (lo, hi) = plc.vertices.iter().fold(
+        (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)),
+        |(l, h), &p| (l.min(p), h.max(p)),
+    );
+    let tol = 1e-8 * (hi - lo).length();
+    let mut by_marker: HashMap<i32, Vec<usize>> = HashMap::new();
+    for (i, f) in plc.facets.iter().enumerate() {
+        by_marker.entry(f.marker).or_default().push(i);
+    }
+    let inside = |f: &slivermesh::plc::PlcFacet, q: DVec3| {
+        f.triangles.iter().any(|t| {
+            let [a, b, c] = t.map(|v| plc.vertices[v as usize]);
+            // Barycentric coordinates in the facet plane, each >= -tol (relative).
+            let n = (b - a).cross(c - a);
+            let nn = n.length_squared();
+            let w = [
+                (c - b).cross(q - b).dot(n) / nn,
+                (a - c).cross(q - c).dot(n) / nn,
+                (b - a).cross(q - a).dot(n) / nn,
+            ];
+            w.iter().all(|&x| x >= -1e-9)
+        })
+    };
+    for (k, (t, mk)) in m.boundary.iter().zip(&m.boundary_markers).enumerate() {
+        let p = t.map(|v| m.vertices[v as usize]);
+        let centroid = (p[0] + p[1] + p[2]) / 3.0;
+        let on_facet = by_marker.get(mk).into_iter().flatten().any(|&i| {
+            let f = &plc.facets[i];
+            p.iter().all(|&q| f.plane.distance(q).abs() <= tol) && inside(f, centroid)
+        });
+        assert!(
+            on_facet,
+            "{rel}: boundary triangle {k} {t:?} (marker {mk}) is not on an input facet with that marker"
+        );
+    }
+}
+
 pub fn rel_close(a: f64, b: f64, tol: f64) -> bool {
     (a - b).abs() <= tol * b.abs().max(1e-300)
 }
@@ -167,6 +209,7 @@ pub fn check_conforming(rel: &str, input: &PlcInput, m: &TetMesh, volume: Option
         );
     }
     assert_eq!(want.len(), got.len(), "{rel}: markers");
+    check_on_input_surface(rel, input, m);
     if let Some(v) = volume.or_else(|| enclosed_volume(input)) {
         let vol = total_volume(m);
         assert!(rel_close(vol, v, 1e-9), "{rel}: volume {vol}, expected {v}");
