@@ -254,3 +254,44 @@ fn slivers_of_an_existing_mesh_are_removed() {
         "the input already had no sliver: {before}"
     );
 }
+
+/// The minimum of several spacings: a fine zone inside a coarse constant spacing; a bad value
+/// of any of them fails the run (the minimum does not hide a NaN).
+#[test]
+fn minimum_of_spacings_is_respected_and_keeps_bad_values() {
+    use slivermesh::refine::{MeshError, MinSpacing};
+    let fine_zone = |p: DVec3| if p.x < 0.3 { 0.06 } else { 10.0 };
+    let f = MinSpacing(vec![
+        Box::new(ConstantSpacing(0.2)),
+        Box::new(FnSpacing(fine_zone)),
+    ]);
+    assert_eq!(f.at(DVec3::new(0.1, 0.5, 0.5)), 0.06);
+    assert_eq!(f.at(DVec3::new(0.9, 0.5, 0.5)), 0.2);
+    let params = Params::default();
+    let m = refined("poly/cube.poly", Some(1.0), &params, Some(&f));
+    let (mut fine, mut coarse) = (0, 0);
+    for t in &m.tets {
+        let [a, b, c, d] = t.map(|v| m.vertices[v as usize]);
+        let q = TetQuality::of(a, b, c, d);
+        let centre = q.circumcenter.unwrap();
+        assert!(q.circumradius / f.at(centre) <= params.size_factor * (1.0 + 1e-9));
+        if centre.x < 0.3 {
+            fine += 1;
+        } else {
+            coarse += 1;
+        }
+    }
+    // The fine zone is 3/7 of the volume of the coarse one but holds far more tets.
+    assert!(fine > 3 * coarse, "fine {fine}, coarse {coarse}");
+    let broken = MinSpacing(vec![
+        Box::new(ConstantSpacing(0.2)),
+        Box::new(FnSpacing(|p: DVec3| if p.x > 0.5 { f64::NAN } else { 1.0 })),
+    ]);
+    let input = read_model("poly/cube.poly");
+    let r = mesh(&input, &params, Some(&broken), None);
+    assert!(
+        matches!(r, Err(MeshError::BadSpacing { value, .. }) if value.is_nan()),
+        "{:?}",
+        r.err()
+    );
+}

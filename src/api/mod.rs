@@ -27,7 +27,7 @@ pub use spacing::SpacingChoice;
 
 pub use crate::mesh::TetMesh;
 pub use crate::plc::PlcInput;
-pub use crate::refine::{ConstantSpacing, FnSpacing, MeshError, Report, Spacing};
+pub use crate::refine::{ConstantSpacing, FnSpacing, MeshError, MinSpacing, Report, Spacing};
 
 #[cfg(test)]
 mod tests;

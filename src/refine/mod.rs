@@ -133,6 +133,24 @@ impl<F: Fn(DVec3) -> f64> Spacing for FnSpacing<F> {
     }
 }
 
+/// The smallest of several spacings at every point (e.g. a fine zone's f and a global one).
+/// A value that is not finite and positive is passed on as it is (not dropped by the minimum),
+/// so the run fails naming the point.
+pub struct MinSpacing(pub Vec<Box<dyn Spacing + Send>>);
+impl Spacing for MinSpacing {
+    fn at(&self, p: DVec3) -> f64 {
+        let mut f = f64::INFINITY;
+        for s in &self.0 {
+            let v = s.at(p);
+            if !(v.is_finite() && v > 0.0) {
+                return v;
+            }
+            f = f.min(v);
+        }
+        f
+    }
+}
+
 /// What a run achieved.
 #[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
 pub struct Report {
