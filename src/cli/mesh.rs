@@ -146,8 +146,16 @@ fn finish(
     Ok(())
 }
 
-/// Writes the mesh with per-tet quality as cell data (radius-edge ratio, sigma, min dihedral).
+/// Writes the mesh, with per-tet quality as cell data (radius-edge ratio, sigma, min dihedral)
+/// when the format is .vtu.
 pub fn write_with_quality(path: &Path, mesh: &TetMesh) -> Result<(), String> {
+    // Only .vtu has a place for cell data: measuring every tet for another format is wasted.
+    if !path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("vtu"))
+    {
+        return io::write_mesh(path, mesh, &[]).map_err(|e| e.to_string());
+    }
     let mut rho = Vec::with_capacity(mesh.tets.len());
     let mut sigma = Vec::with_capacity(mesh.tets.len());
     let mut dihedral = Vec::with_capacity(mesh.tets.len());

@@ -211,35 +211,6 @@ impl std::fmt::Display for MeshError {
 }
 impl std::error::Error for MeshError {}
 
-/// Final tets violating rho0, sigma0 or min_dihedral: (within the influence of an acute
-/// input angle — a vertex next to a small angle or in the protecting ball of an acute input
-/// vertex —, elsewhere).
-fn count_bad(
-    dom: &domain::Domain,
-    mesh: &TetMesh,
-    params: &Params,
-    blocked: &FxHashSet<[u32; 4]>,
-) -> (usize, usize) {
-    let mut near = 0;
-    let mut other = 0;
-    for t in &mesh.tets {
-        let [a, b, c, d] = t.map(|v| mesh.vertices[v as usize]);
-        let q = crate::geom::TetQuality::of(a, b, c, d);
-        let bad =
-            q.rho > params.rho0 || q.sigma < params.sigma0 || q.min_dihedral < params.min_dihedral;
-        if bad {
-            if t.iter().any(|&v| dom.influenced_by_acute_angle(v))
-                || blocked.contains(&quality::sorted4(*t))
-            {
-                near += 1;
-            } else {
-                other += 1;
-            }
-        }
-    }
-    (near, other)
-}
-
 /// Refinement passes at most (each re-marks regions and re-checks every tet; the second pass
 /// almost always finds nothing to do).
 const MAX_PASSES: usize = 4;
@@ -318,13 +289,15 @@ fn mesh_domain(
     }
     let seconds_refinement = start.elapsed().as_secs_f64() - seconds_recovery;
     let mesh = dom.to_mesh(&regions);
-    let mut report = report::measure(&mesh, spacing, params)?;
-    let (bad_near_acute, bad_elsewhere) = count_bad(&dom, &mesh, params, &blocked);
+    let near_acute = |t: &[u32; 4]| {
+        t.iter().any(|&v| dom.influenced_by_acute_angle(v))
+            || blocked.contains(&quality::sorted4(*t))
+    };
+    let (mut report, bad_elsewhere) = report::measure(&mesh, spacing, params, &near_acute)?;
     report.seconds_recovery = seconds_recovery;
     report.seconds_refinement = seconds_refinement;
     report.seconds_total = start.elapsed().as_secs_f64();
     report.n_acute_angles = dom.acute_vertices.len();
-    report.n_bad_near_acute = bad_near_acute;
     report.complete = stop_reason.is_none() && (bad_elsewhere == 0 || !params.refine);
     if params.refine && stop_reason.is_none() && bad_elsewhere > 0 {
         stop_reason = Some(format!(

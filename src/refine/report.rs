@@ -4,19 +4,25 @@ use super::{MeshError, Params, Report, Spacing};
 use crate::geom::TetQuality;
 use crate::mesh::TetMesh;
 
-/// Measures `mesh` (tets only; timings and completion are filled in by the caller).
+/// Measures `mesh` (tets only; timings and completion are filled in by the caller). Tets that
+/// miss a bound of `params` are counted in `n_bad_near_acute` when `near_acute(tet)` says so;
+/// the others are returned.
 pub fn measure(
     mesh: &TetMesh,
     spacing: &dyn Spacing,
-    _params: &Params,
-) -> Result<Report, MeshError> {
+    params: &Params,
+    near_acute: &dyn Fn(&[u32; 4]) -> bool,
+) -> Result<(Report, usize), MeshError> {
+    let mut bad_elsewhere = 0;
     let mut r = Report {
-        n_vertices: mesh
-            .tets
-            .iter()
-            .flatten()
-            .collect::<std::collections::BTreeSet<_>>()
-            .len(),
+        n_vertices: {
+            let mut used = vec![false; mesh.vertices.len()];
+            mesh.tets
+                .iter()
+                .flatten()
+                .for_each(|&v| used[v as usize] = true);
+            used.iter().filter(|&&u| u).count()
+        },
         n_tets: mesh.tets.len(),
         n_boundary_faces: mesh.boundary.len(),
         min_sigma: f64::INFINITY,
@@ -24,13 +30,20 @@ pub fn measure(
         ..Default::default()
     };
     let p = |v: u32| mesh.vertices[v as usize];
-    let mut edges = vec![];
+    let mut edges: Vec<u64> = Vec::with_capacity(6 * mesh.tets.len());
     for t in &mesh.tets {
         let q = TetQuality::of(p(t[0]), p(t[1]), p(t[2]), p(t[3]));
         r.max_rho = r.max_rho.max(q.rho);
         r.min_sigma = r.min_sigma.min(q.sigma);
         r.min_dihedral_deg = r.min_dihedral_deg.min(q.min_dihedral);
         r.max_dihedral_deg = r.max_dihedral_deg.max(q.max_dihedral);
+        if q.rho > params.rho0 || q.sigma < params.sigma0 || q.min_dihedral < params.min_dihedral {
+            if near_acute(t) {
+                r.n_bad_near_acute += 1;
+            } else {
+                bad_elsewhere += 1;
+            }
+        }
         for (k, limit) in [5.0, 10.0, 15.0, 20.0].iter().enumerate() {
             if q.min_dihedral < *limit {
                 r.tets_below_deg[k] += 1;
@@ -42,28 +55,32 @@ pub fn measure(
         }
         for i in 0..4 {
             for j in i + 1..4 {
-                edges.push((t[i].min(t[j]), t[i].max(t[j])));
+                // One u64 key per edge (smaller id in the high half): sorts faster than pairs.
+                edges.push(((t[i].min(t[j]) as u64) << 32) | t[i].max(t[j]) as u64);
             }
         }
     }
     edges.sort_unstable();
     edges.dedup();
     let mut ratios = Vec::with_capacity(edges.len());
-    for (a, b) in edges {
+    for key in edges {
+        let (a, b) = ((key >> 32) as u32, key as u32);
         let mid = (p(a) + p(b)) * 0.5;
         ratios.push(p(a).distance(p(b)) / checked(spacing, mid)?);
     }
-    ratios.sort_unstable_by(f64::total_cmp);
     if !ratios.is_empty() {
-        r.edge_ratio_min = ratios[0];
-        r.edge_ratio_median = ratios[ratios.len() / 2];
-        r.edge_ratio_max = ratios[ratios.len() - 1];
+        // The element a full sort would put at len / 2, without the sort.
+        let mid = ratios.len() / 2;
+        let (below, median, above) = ratios.select_nth_unstable_by(mid, f64::total_cmp);
+        r.edge_ratio_median = *median;
+        r.edge_ratio_min = below.iter().copied().fold(*median, f64::min);
+        r.edge_ratio_max = above.iter().copied().fold(*median, f64::max);
     }
     if mesh.tets.is_empty() {
         r.min_sigma = 0.0;
         r.min_dihedral_deg = 0.0;
     }
-    Ok(r)
+    Ok((r, bad_elsewhere))
 }
 
 fn checked(spacing: &dyn Spacing, p: glam::DVec3) -> Result<f64, MeshError> {
