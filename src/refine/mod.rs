@@ -211,6 +211,19 @@ impl std::fmt::Display for MeshError {
 }
 impl std::error::Error for MeshError {}
 
+/// The region tag of every tet slot (dead slots: u32::MAX).
+fn tet_tags(dom: &domain::Domain) -> Vec<u32> {
+    (0..dom.dt.tet_capacity() as u32)
+        .map(|t| {
+            if dom.dt.is_alive(t) {
+                dom.dt.tag(t)
+            } else {
+                u32::MAX
+            }
+        })
+        .collect()
+}
+
 /// Refinement passes at most (each re-marks regions and re-checks every tet; the second pass
 /// almost always finds nothing to do).
 const MAX_PASSES: usize = 4;
@@ -280,9 +293,17 @@ fn mesh_domain(
             // A boundary split can delete a subfacet of another facet for a moment, letting
             // region labels leak across it: check the whole boundary, re-mark from the seeds
             // and look at every tet again until a pass changes nothing.
+            let refined = dom.dt.num_vertices();
+            let tags = tet_tags(&dom);
             dom.recover_boundary(&mut budget)?;
             regions = dom.mark_domain(input, unseeded)?;
             if stop_reason.is_some() || dom.dt.num_vertices() == before {
+                break;
+            }
+            // Every tet was classified when it was made and the queues are empty: when the
+            // check and the re-marking changed nothing, another pass would only meet the
+            // tets already left alone.
+            if dom.dt.num_vertices() == refined && tet_tags(&dom) == tags {
                 break;
             }
         }
