@@ -295,3 +295,36 @@ fn minimum_of_spacings_is_respected_and_keeps_bad_values() {
         r.err()
     );
 }
+
+/// A shorter reach of small angles' influence (`small_angle_reach`): still terminates,
+/// conforms and completes, every bad tet is within the (smaller) influence, and fewer are left
+/// than with the default (whole facets) on a model whose small angles sit on large facets.
+#[test]
+fn shorter_small_angle_reach_leaves_fewer_bad_tets() {
+    let input = read_model("off/joint.off");
+    let default = Params::default();
+    let short = Params {
+        small_angle_reach: 2.0,
+        ..Params::default()
+    };
+    let (_, wide) = mesh(&input, &default, None, None).unwrap();
+    let (m, report) = mesh(&input, &short, None, None).unwrap();
+    assert!(report.complete, "{:?}", report.stop_reason);
+    check_conforming("off/joint.off", &input, &m, None);
+    let bad = m
+        .tets
+        .iter()
+        .filter(|t| {
+            let [a, b, c, d] = t.map(|v| m.vertices[v as usize]);
+            let q = TetQuality::of(a, b, c, d);
+            q.rho > short.rho0 || q.sigma < short.sigma0 || q.min_dihedral < short.min_dihedral
+        })
+        .count();
+    assert_eq!(bad, report.n_bad_near_acute);
+    assert!(
+        report.n_bad_near_acute < wide.n_bad_near_acute * 9 / 10,
+        "reach 2: {} bad tets, default: {}",
+        report.n_bad_near_acute,
+        wide.n_bad_near_acute
+    );
+}

@@ -19,6 +19,7 @@ pub const PARAM_NAMES: &[&str] = &[
     "max_vertices",
     "max_tries",
     "refine",
+    "small_angle_reach",
 ];
 
 /// Smallest accepted `rho0` (the refiner's own limit, `Params::check`).
@@ -37,7 +38,7 @@ const MAX_EXACT_INT: f64 = 9_007_199_254_740_992.0; // 2^53
 /// `sigma0` (in [0, 0.1179): 0 turns the sigma test off), `min_dihedral` (degrees, in
 /// [0, 70.5): 0 turns the angle test off), `delta` (in (0, 1)), `b` (> 0), `size_factor` or `B`
 /// (> 0), `seed` (integer in [0, 2^53]), `max_vertices` (integer >= 4), `max_tries`
-/// (integer >= 1), `refine` (0 or 1). Integer parameters must be given as whole numbers.
+/// (integer >= 1), `refine` (0 or 1), `small_angle_reach` (> 0, may be infinite). Integer parameters must be given as whole numbers.
 /// The result also passes `Params::check` (the refiner's own validation), so a value accepted
 /// here is never refused by `refine`.
 pub fn set_param(params: &mut Params, name: &str, value: f64) -> Result<(), Error> {
@@ -104,6 +105,15 @@ fn set_unchecked(params: &mut Params, name: &str, value: f64) -> Result<(), Erro
         "seed" => params.seed = whole(name, value, 0.0)? as u64,
         "max_vertices" => params.max_vertices = whole(name, value, 4.0)? as usize,
         "max_tries" => params.max_tries = whole(name, value, 1.0)? as usize,
+        "small_angle_reach" => {
+            if value.is_nan() || value <= 0.0 {
+                return invalid(format!(
+                    "small_angle_reach = {value} must be > 0: the reach of a small input \
+                     angle's influence in protecting-ball radii (infinity: whole facets)"
+                ));
+            }
+            params.small_angle_reach = value;
+        }
         "refine" => {
             params.refine = match value {
                 0.0 => false,
@@ -139,6 +149,7 @@ pub fn get_param(params: &Params, name: &str) -> Result<f64, Error> {
         "max_vertices" => params.max_vertices as f64,
         "max_tries" => params.max_tries as f64,
         "refine" => f64::from(u8::from(params.refine)),
+        "small_angle_reach" => params.small_angle_reach,
         _ => {
             return invalid(format!(
                 "unknown parameter \"{name}\"; valid names: {}",
@@ -205,6 +216,7 @@ mod tests {
             ("max_vertices", 1000.0),
             ("max_tries", 7.0),
             ("refine", 0.0),
+            ("small_angle_reach", 2.0),
         ];
         assert_eq!(values.len(), PARAM_NAMES.len());
         for (name, v) in values {
@@ -246,6 +258,10 @@ mod tests {
         assert!(err("max_vertices", 3.0).contains("out of range"));
         assert!(err("max_tries", 0.0).contains("out of range"));
         assert!(err("refine", 0.5).contains("0"));
+        assert!(err("small_angle_reach", 0.0).contains("> 0"));
+        assert!(err("small_angle_reach", -1.0).contains("> 0"));
+        let mut p = Params::default();
+        set_param(&mut p, "small_angle_reach", f64::INFINITY).unwrap();
     }
 
     #[test]

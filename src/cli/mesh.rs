@@ -35,6 +35,11 @@ pub struct MeshOptions {
     /// Stop refining at this many vertices (the report then says complete: false).
     #[arg(long, value_name = "N")]
     pub max_vertices: Option<usize>,
+    /// Reach of a small input angle's influence along its segments and facets, in
+    /// protecting-ball radii (default: infinite, whole facets); 2 to 8 leave fewer bad tets
+    /// next to small angles for more vertices and time.
+    #[arg(long, value_name = "K")]
+    pub small_angle_reach: Option<f64>,
     /// Keep .off/.stl triangles as separate facets instead of merging coplanar ones.
     #[arg(long)]
     pub no_merge: bool,
@@ -60,6 +65,9 @@ impl MeshOptions {
         }
         if let Some(v) = self.max_vertices {
             p.max_vertices = v;
+        }
+        if let Some(v) = self.small_angle_reach {
+            p.small_angle_reach = v;
         }
         p
     }

@@ -14,7 +14,9 @@ use std::ffi::{c_char, c_void};
 /// default 4), "size_factor" or "B" (R/f(c) bound > 0, default 1), "seed" (whole number,
 /// default 1), "max_vertices" (whole number, at least 4; refinement stops there, reporting
 /// complete = 0), "max_tries" (whole number, at least 1), "refine" (1, or 0 for boundary
-/// recovery only).
+/// recovery only), "small_angle_reach" (> 0, default infinity: how far, in protecting-ball
+/// radii, the influence of a vertex where segments meet below 60 degrees reaches along its
+/// segments and facets; 2 to 8 leave fewer bad tets there for more vertices and time).
 /// An unknown name or out-of-range value gives `SM_ERR_INVALID_ARGUMENT`; `sm_last_error`
 /// says why (and lists the valid names).
 ///

@@ -44,11 +44,15 @@ pub struct Domain {
     pub acute_vertices: FxHashSet<u32>,
     /// Input vertices where segments meet at a small angle (< SMALL_ANGLE_DEG).
     pub small_angle_vertices: FxHashSet<u32>,
-    /// Input segments (indices into `segments`) in a small input angle: between two facets
-    /// meeting at less than SMALL_ANGLE_DEG, or ending at a small-angle vertex.
+    /// Input segments (indices into `segments`) between two facets meeting at less than
+    /// SMALL_ANGLE_DEG: the whole segment is a small angle.
     pub acute_segments: FxHashSet<u32>,
-    /// Input facets holding a small-angle vertex or segment.
+    /// Input facets around an acute segment.
     pub acute_facets: FxHashSet<u32>,
+    /// Per vertex: within the influence of a small input angle (see `near_acute`).
+    near_small_angle: Vec<bool>,
+    /// `Params::small_angle_reach`.
+    small_angle_reach: f64,
     /// Protecting balls around the acute input vertices: vertex -> radius. Inside one,
     /// boundary elements are split only when missing from the triangulation, not when merely
     /// encroached (Pav & Walkington's protection): near an acute apex, splits encroach each
@@ -151,6 +155,8 @@ impl Domain {
             small_angle_vertices: FxHashSet::default(),
             acute_segments: FxHashSet::default(),
             acute_facets: FxHashSet::default(),
+            near_small_angle: vec![false; input.vertices.len()],
+            small_angle_reach: f64::INFINITY,
             dirty_segs: vec![],
             dirty_tris: vec![],
             created_log: vec![],
@@ -160,7 +166,8 @@ impl Domain {
     /// Records the small input angles the validator found (see `near_acute`) and puts a
     /// protecting ball around every acute input vertex (see `protect_radius`). Not called for
     /// the boundary of an existing mesh, whose angles are not features.
-    pub fn set_acute_angles(&mut self, plc: &crate::plc::Plc) {
+    pub fn set_acute_angles(&mut self, plc: &crate::plc::Plc, reach: f64) {
+        self.small_angle_reach = reach;
         for &v in &self.acute_vertices {
             let r = PROTECT_FRACTION * nearest_neighbor_distance(&self.dt, v);
             self.protect_radius.insert(v, r);
@@ -198,33 +205,51 @@ impl Domain {
                 self.acute_segments.insert(s);
             }
         }
-        for (i, s) in self.segments.iter().enumerate() {
-            if s.ends.iter().any(|v| self.small_angle_vertices.contains(v)) {
-                self.acute_segments.insert(i as u32);
-            }
-        }
         for &s in &self.acute_segments {
             self.acute_facets
                 .extend(self.segments[s as usize].facets.iter().copied());
+        }
+        self.near_small_angle = (0..self.kind.len() as u32)
+            .map(|v| self.is_near_small_angle(v, self.point(v), self.kind[v as usize]))
+            .collect();
+    }
+
+    /// See `near_acute`; for a vertex `v` at `p` of kind `kind` (its apex already recorded).
+    fn is_near_small_angle(&self, v: u32, p: DVec3, kind: VertexKind) -> bool {
+        let apex = self.apex[v as usize];
+        if apex != NO_APEX && self.small_angle_vertices.contains(&apex) {
+            return true;
+        }
+        // Within reach of a small-angle vertex `e` of the element the vertex lies on.
+        let reach = self.small_angle_reach;
+        let reaches = |e: &u32| {
+            self.small_angle_vertices.contains(e)
+                && self
+                    .protect_radius
+                    .get(e)
+                    .is_some_and(|&r| self.point(*e).distance(p) < reach * r)
+        };
+        match kind {
+            VertexKind::Input => self.small_angle_vertices.contains(&v),
+            VertexKind::Segment(s) => {
+                self.acute_segments.contains(&s)
+                    || self.segments[s as usize].ends.iter().any(reaches)
+            }
+            VertexKind::Facet(f) => {
+                self.acute_facets.contains(&f) || self.facet_apexes[f as usize].iter().any(reaches)
+            }
+            VertexKind::Volume => false,
         }
     }
 
     /// Whether vertex `v` is within the influence of a small input angle, where quality
     /// cannot always be enforced without an endless cascade of boundary splits: in the
-    /// protecting ball of a vertex where segments meet at a small angle, on a segment in a
-    /// small angle (between facets, or ending at a small-angle vertex) or on a facet holding
-    /// one.
+    /// protecting ball of a vertex where segments meet at a small angle, on a segment between
+    /// facets meeting at a small angle or on one of those facets, or on a segment or facet
+    /// holding a small-angle vertex and within `Params::small_angle_reach` protecting-ball
+    /// radii of it (computed once per vertex, when it is inserted).
     pub fn near_acute(&self, v: u32) -> bool {
-        let apex = self.apex[v as usize];
-        if apex != NO_APEX && self.small_angle_vertices.contains(&apex) {
-            return true;
-        }
-        match self.kind[v as usize] {
-            VertexKind::Input => self.small_angle_vertices.contains(&v),
-            VertexKind::Segment(s) => self.acute_segments.contains(&s),
-            VertexKind::Facet(f) => self.acute_facets.contains(&f),
-            VertexKind::Volume => false,
-        }
+        self.near_small_angle[v as usize]
     }
 
     /// The acute input vertex whose protecting ball holds a new boundary point `p` (the
@@ -284,6 +309,8 @@ impl Domain {
                 let apex = self.apex_of(p, kind);
                 self.kind.push(kind);
                 self.apex.push(apex);
+                let near = self.is_near_small_angle(id, p, kind);
+                self.near_small_angle.push(near);
                 self.queue_around_last_insertion();
                 self.created_log.extend_from_slice(self.dt.last_created());
                 Ok(id)

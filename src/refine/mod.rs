@@ -45,6 +45,13 @@ pub struct Params {
     pub max_tries: usize,
     /// When false, only recover the boundary (no quality refinement).
     pub refine: bool,
+    /// How far the influence of a vertex where segments meet below 60 degrees reaches along
+    /// its segments and facets, in radii of its protecting ball (0.4 x the distance to its
+    /// nearest input vertex). Within it shape is enforced only by circumcentres that break no
+    /// boundary. Infinite (the default): whole segments and facets holding such a vertex.
+    /// Smaller values (2 to 8) leave fewer bad tets next to small angles, at the price of more
+    /// vertices and time on some models (docs/parameters.md).
+    pub small_angle_reach: f64,
 }
 
 impl Default for Params {
@@ -60,6 +67,7 @@ impl Default for Params {
             max_vertices: 10_000_000,
             max_tries: 20,
             refine: true,
+            small_angle_reach: f64::INFINITY,
         }
     }
 }
@@ -79,6 +87,12 @@ impl Params {
                     "parameter {name} = {v} must be finite and positive"
                 ));
             }
+        }
+        if self.small_angle_reach.is_nan() || self.small_angle_reach <= 0.0 {
+            return Err(format!(
+                "parameter small_angle_reach = {} must be > 0 (infinite: whole facets)",
+                self.small_angle_reach
+            ));
         }
         if !(self.sigma0.is_finite() && self.sigma0 >= 0.0) {
             return Err(format!(
@@ -259,7 +273,7 @@ fn mesh_domain(
     let plc = crate::plc::validate(input).map_err(|e| MeshError::InvalidInput(e.to_string()))?;
     let mut dom = domain::Domain::new(input)?;
     if respect_small_angles {
-        dom.set_acute_angles(&plc);
+        dom.set_acute_angles(&plc, params.small_angle_reach);
     }
     let mut budget = recover::MAX_RECOVERY_SPLITS.min(params.max_vertices.saturating_mul(4));
     dom.recover_boundary(&mut budget)?;
