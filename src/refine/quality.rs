@@ -327,6 +327,19 @@ impl<'a> Refiner<'a> {
             self.deferred.push_back(bad);
             return Ok(());
         }
+        if !may_defer && r > DEFER_RADIUS_PER_EDGE * longest_edge(a, b, c, d) {
+            // A deferred flat tet whose circumcentre lies outside the domain: probing that
+            // centre means a huge cavity (thousands of tets) that crosses the boundary, which
+            // can only end in a refused split (the boundary element is far smaller than R).
+            // Restoring the boundary around it is all that can help.
+            let t = self.dom.dt.locate_point(centre, Some(bad.tet));
+            if !self.dom.dt.is_finite(t) || self.dom.dt.tag(t) == 0 {
+                if !self.resettle_near(bad.tet)? {
+                    self.gave_up += 1;
+                }
+                return Ok(());
+            }
+        }
         let centre_breaks = self.encroached_boundary(centre, Some(bad.tet));
         if near {
             // An empty probed cavity: the centre is a vertex already.
