@@ -167,6 +167,14 @@ static void test_params(void) {
     CHECK_STATUS(m, sm_set_param(m, "min_dihedral", 12), SM_OK);
     CHECK_STATUS(m, sm_get_param(m, "min_dihedral", &v), SM_OK);
     CHECK(v == 12.0);
+    CHECK_STATUS(m, sm_get_param(m, "small_angle_reach", &v), SM_OK);
+    CHECK(isinf(v) && v > 0); /* default: whole facets */
+    CHECK_STATUS(m, sm_set_param(m, "small_angle_reach", 2), SM_OK);
+    CHECK_STATUS(m, sm_get_param(m, "small_angle_reach", &v), SM_OK);
+    CHECK(v == 2.0);
+    CHECK_STATUS(m, sm_set_param(m, "small_angle_reach", INFINITY), SM_OK);
+    CHECK_STATUS(m, sm_set_param(m, "small_angle_reach", 0), SM_ERR_INVALID_ARGUMENT);
+    CHECK_ERROR_HAS(m, "small_angle_reach");
 
     CHECK_STATUS(m, sm_set_param(m, "rh0", 2), SM_ERR_INVALID_ARGUMENT);
     CHECK_ERROR_HAS(m, "\"rh0\"");
