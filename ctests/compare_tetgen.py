@@ -166,7 +166,9 @@ def run_tetgen(exe, poly, workdir, volume, quality):
     """tetgen -pq<quality>a<volume>Q on a copy of poly in workdir; returns the result dict."""
     d = os.path.join(workdir, "tetgen")
     os.makedirs(d, exist_ok=True)
-    src = os.path.join(d, "input.poly")
+    # Keep the extension: tetgen picks its reader by it (.poly, .smesh, .off, .stl, ...).
+    name = "input" + os.path.splitext(poly)[1].lower()
+    src = os.path.join(d, name)
     if not os.path.exists(src):
         shutil.copyfile(poly, src)
     for ext in ("node", "ele", "face", "edge"):
@@ -175,7 +177,7 @@ def run_tetgen(exe, poly, workdir, volume, quality):
         except FileNotFoundError:
             pass
     switches = "-pq%sa%.10gQ" % (quality, volume)
-    _, seconds = run_timed([exe, switches, "input.poly"], cwd=d)
+    _, seconds = run_timed([exe, switches, name], cwd=d)
     stem = os.path.join(d, "input.1")
     if not os.path.exists(stem + ".ele"):
         raise Failure("tetgen %s wrote no %s.ele" % (switches, stem))
@@ -214,7 +216,7 @@ def main():
     ap.add_argument("--slivermesh", default=os.path.join(here, "..", "target", "release", "slivermesh"))
     ap.add_argument("--tetgen", default=shutil.which("tetgen") or "/usr/bin/tetgen")
     ap.add_argument("--input", default=None,
-                    help="a .poly both programs read (default: ../../shared/models/poly/cube.poly)")
+                    help="a .poly (or .off/.stl) both programs read (default: ../../shared/models/poly/cube.poly)")
     ap.add_argument("--tets", type=int, default=20000, help="target number of tets (default 20000)")
     ap.add_argument("--quality", default="1.414", help="tetgen's -q radius-edge bound (default 1.414)")
     ap.add_argument("--repeat", type=int, default=3, help="timed runs per program, best kept (default 3)")
