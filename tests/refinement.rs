@@ -203,6 +203,23 @@ fn acute_models_terminate_and_meet_bounds_away_from_small_angles() {
             })
             .count();
         assert_eq!(bad, report.n_bad_near_acute, "{rel}");
+        // No tet of (numerically) no volume: four cocircular vertices of a facet, a rounding
+        // error off its plane, are left out of the output (refine/output.rs). Before that,
+        // spool had 351, rotor 327, anchor 149; the few left are other configurations.
+        let flat = m
+            .tets
+            .iter()
+            .filter(|t| {
+                let [a, b, c, d] = t.map(|v| m.vertices[v as usize]);
+                TetQuality::of(a, b, c, d).sigma < 1e-9
+            })
+            .count();
+        let allowed = if ["off/part.off", "off/rotor.off"].contains(&rel) {
+            5
+        } else {
+            0
+        };
+        assert!(flat <= allowed, "{rel}: {flat} tets of no volume");
     }
 }
 
