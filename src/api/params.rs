@@ -38,7 +38,8 @@ const MAX_EXACT_INT: f64 = 9_007_199_254_740_992.0; // 2^53
 /// `sigma0` (in [0, 0.1179): 0 turns the sigma test off), `min_dihedral` (degrees, in
 /// [0, 70.5): 0 turns the angle test off), `delta` (in (0, 1)), `b` (> 0), `size_factor` or `B`
 /// (> 0), `seed` (integer in [0, 2^53]), `max_vertices` (integer >= 4), `max_tries`
-/// (integer >= 1), `refine` (0 or 1), `small_angle_reach` (> 0, may be infinite). Integer parameters must be given as whole numbers.
+/// (integer >= 1), `refine` (0 or 1), `small_angle_reach` (> 0, may be infinite). Integer
+/// parameters must be given as whole numbers.
 /// The result also passes `Params::check` (the refiner's own validation), so a value accepted
 /// here is never refused by `refine`.
 pub fn set_param(params: &mut Params, name: &str, value: f64) -> Result<(), Error> {

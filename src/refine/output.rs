@@ -9,10 +9,10 @@
 //! quad's other diagonal, on the same plane up to rounding) become the boundary triangles
 //! instead. The facet is still tiled exactly and every remaining tet is still Delaunay.
 
-use super::domain::{tri_key, Domain};
+use super::domain::{tri_key, Domain, VertexKind};
 use super::mark::Regions;
 use crate::delaunay::tables::FACE;
-use crate::geom::orient3d;
+use crate::geom::{shortest_edge, volume};
 use crate::mesh::TetMesh;
 use rustc_hash::FxHashSet;
 
@@ -85,18 +85,18 @@ impl Domain {
         let inside = |t: u32| self.dt.is_finite(t) && self.dt.tag(t) != 0;
         let mut found = vec![];
         for t in self.dt.finite_tet_ids() {
-            if self.dt.tag(t) == 0 {
+            let v = self.dt.tet(t);
+            // Two faces on one facet: all four vertices on the boundary (cheap test first).
+            if self.dt.tag(t) == 0
+                || v.iter()
+                    .any(|&k| self.kind[k as usize] == VertexKind::Volume)
+            {
                 continue;
             }
             let [a, b, c, d] = self.dt.tet_points(t);
-            let l2 = [b - a, c - a, d - a, c - b, d - b, d - c]
-                .map(|e| e.length_squared())
-                .into_iter()
-                .fold(f64::INFINITY, f64::min);
-            if orient3d(a, b, c, d).abs() / 6.0 >= FLAT_SIGMA * l2 * l2.sqrt() {
+            if volume(a, b, c, d).abs() >= FLAT_SIGMA * shortest_edge(a, b, c, d).powi(3) {
                 continue;
             }
-            let v = self.dt.tet(t);
             let nb = self.dt.neighbors(t);
             let (mut on_facet, mut other) = (vec![], vec![]);
             for (i, face) in FACE.iter().enumerate() {

@@ -296,8 +296,8 @@ impl<'a> Refiner<'a> {
         };
         let r = q.circumradius;
         let centroid = (a + b + c + d) * 0.25;
-        if !self.domain_box.contains(centre)
-            && centre.distance(centroid) > FAR_CENTRE_PER_EDGE * longest_edge(a, b, c, d)
+        let le = longest_edge(a, b, c, d);
+        if !self.domain_box.contains(centre) && centre.distance(centroid) > FAR_CENTRE_PER_EDGE * le
         {
             // A nearly flat tet next to the boundary (four almost cocircular points): its
             // circumcentre is outside the domain and far away; it would encroach only
@@ -316,19 +316,19 @@ impl<'a> Refiner<'a> {
         // boundary. Random draws from the picking ball as well cost 3-10x the time there for
         // 10-30% fewer bad tets (measured on the .off models). A tet the centre does not fix
         // is left, counted as within the angle's influence.
-        if near && r > longest_edge(a, b, c, d) {
+        if near && r > le {
             return self.leave_near_small_angle(bad);
         }
         // A flat tet with a far circumcentre (one hugging the boundary, made by a boundary
         // split) waits until every other bad tet is handled: by then most are gone, and its
         // centre's cavity is large (measured on anchor.off: 2,100 tets on average, nearly
         // every one ending in a refused boundary split).
-        if may_defer && r > DEFER_RADIUS_PER_EDGE * longest_edge(a, b, c, d) {
-            self.deferred.push_back(bad);
-            return Ok(());
-        }
-        if !may_defer && r > DEFER_RADIUS_PER_EDGE * longest_edge(a, b, c, d) {
-            // A deferred flat tet whose circumcentre lies outside the domain: probing that
+        if r > DEFER_RADIUS_PER_EDGE * le {
+            if may_defer {
+                self.deferred.push_back(bad);
+                return Ok(());
+            }
+            // Deferred already: when its circumcentre lies outside the domain, probing that
             // centre means a huge cavity (thousands of tets) that crosses the boundary, which
             // can only end in a refused split (the boundary element is far smaller than R).
             // Restoring the boundary around it is all that can help.
@@ -354,9 +354,7 @@ impl<'a> Refiner<'a> {
         }
         if let Some(bnd) = centre_breaks {
             if self.is_protected(bnd) {
-                self.gave_up += 1;
-                self.blocked_by_small_angle.insert(sorted4(bad.verts));
-                return Ok(());
+                return self.leave_near_small_angle(bad);
             }
             let rb = self.boundary_radius(bnd);
             // Without small input angles an encroached boundary element has R >= R_tau / 2
