@@ -13,6 +13,7 @@ pub mod io;
 pub mod mesh;
 pub mod plc;
 pub mod refine;
+pub mod surface;
 
 pub use glam::DVec3;
 pub use mesh::TetMesh;

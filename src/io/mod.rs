@@ -35,7 +35,7 @@ mod text;
 pub mod vtu;
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;
 
 /// An I/O or parse failure, naming the file and (when known) the 1-based line.
 #[derive(Debug, Clone, PartialEq)]

@@ -13,7 +13,7 @@ mod angles;
 mod cells;
 pub mod coplanar;
 mod error;
-mod exact;
+pub(crate) mod exact;
 mod facet;
 mod intersect;
 mod plane;

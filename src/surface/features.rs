@@ -1,0 +1,332 @@
+//! Sharp features of a triangulated surface: which edges are creases, how they join into
+//! polylines between corners, and the smooth patches they bound.
+//!
+//! An edge is a feature when
+//! - it is a border or non-manifold edge (not exactly two triangles),
+//! - its two triangles carry different labels (only when the input has labels of its own,
+//!   [`FeatureParams::use_markers`]; the markers an .off reader invents per face are not
+//!   labels), or
+//! - its two triangles' normals, oriented consistently across the edge, differ by more than
+//!   [`FeatureParams::feature_angle`] degrees.
+//!
+//! Triangles of one planar input facet never meet at a feature. A vertex is a corner when its
+//! number of feature edges is not two, or when the feature curve through it turns by more than
+//! the feature angle. Every traversal runs in vertex/triangle id order, so the result is
+//! deterministic.
+
+use super::InputSurface;
+use glam::DVec3;
+use rustc_hash::FxHashMap;
+
+/// How features are detected.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FeatureParams {
+    /// Normal deviation (degrees) above which an edge is sharp. Default 40.
+    pub feature_angle: f64,
+    /// Whether a change of facet marker makes an edge a feature (true for inputs whose markers
+    /// are labels: .poly/.smesh markers, named STL solids).
+    pub use_markers: bool,
+}
+
+impl Default for FeatureParams {
+    fn default() -> Self {
+        FeatureParams {
+            feature_angle: 40.0,
+            use_markers: false,
+        }
+    }
+}
+
+/// A chain of feature edges between two corners, or a closed loop with no corner on it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Polyline {
+    /// Vertex ids along the curve; for a closed loop the first vertex is not repeated.
+    pub vertices: Vec<u32>,
+    pub closed: bool,
+}
+
+/// The feature graph and patches of a surface.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Features {
+    /// Sharp edges as sorted vertex pairs, ascending.
+    pub edges: Vec<[u32; 2]>,
+    pub polylines: Vec<Polyline>,
+    /// Corner vertices, ascending.
+    pub corners: Vec<u32>,
+    /// Patch of each triangle: triangles connected across non-feature edges share one.
+    pub patch_of: Vec<u32>,
+    pub n_patches: usize,
+}
+
+/// The smallest angle at a corner: between two of its feature curves, or the angle a patch
+/// spans there (the sum of its triangles' angles at the corner).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CornerAngle {
+    pub vertex: u32,
+    /// Degrees.
+    pub angle: f64,
+}
+
+/// Triangles using an edge, each with whether it runs the edge from the smaller id up.
+type EdgeUses = FxHashMap<[u32; 2], Vec<(u32, bool)>>;
+
+fn sorted(a: u32, b: u32) -> [u32; 2] {
+    [a.min(b), a.max(b)]
+}
+
+fn edge_uses(s: &InputSurface) -> EdgeUses {
+    let mut uses: EdgeUses = FxHashMap::default();
+    for (t, tri) in s.triangles.iter().enumerate() {
+        for j in 0..3 {
+            let (a, b) = (tri[j], tri[(j + 1) % 3]);
+            uses.entry(sorted(a, b))
+                .or_default()
+                .push((t as u32, a < b));
+        }
+    }
+    uses
+}
+
+fn angle_deg(u: DVec3, v: DVec3) -> f64 {
+    // atan2 of |u x v| and u.v is accurate at every angle, unlike acos near 0 and 180.
+    u.cross(v).length().atan2(u.dot(v)).to_degrees()
+}
+
+/// Normal deviation across a two-triangle edge, with the normals oriented consistently (a
+/// consistently oriented pair runs the edge in opposite directions).
+fn normal_deviation(s: &InputSurface, (t1, up1): (u32, bool), (t2, up2): (u32, bool)) -> f64 {
+    let n1 = s.normal(t1 as usize);
+    let mut n2 = s.normal(t2 as usize);
+    if up1 == up2 {
+        n2 = -n2;
+    }
+    if n1 == DVec3::ZERO || n2 == DVec3::ZERO {
+        return 180.0;
+    }
+    angle_deg(n1, n2)
+}
+
+fn is_feature(s: &InputSurface, p: &FeatureParams, uses: &[(u32, bool)]) -> bool {
+    let [u1, u2] = match uses {
+        [u1, u2] => [*u1, *u2],
+        _ => return true,
+    };
+    let (t1, t2) = (u1.0 as usize, u2.0 as usize);
+    if s.facet_of[t1] == s.facet_of[t2] {
+        return false;
+    }
+    if p.use_markers && s.marker_of[t1] != s.marker_of[t2] {
+        return true;
+    }
+    normal_deviation(s, u1, u2) > p.feature_angle
+}
+
+impl Features {
+    /// Detects the features of `s`.
+    pub fn detect(s: &InputSurface, p: &FeatureParams) -> Features {
+        let uses = edge_uses(s);
+        let mut keys: Vec<[u32; 2]> = uses.keys().copied().collect();
+        keys.sort_unstable();
+        let edges: Vec<[u32; 2]> = keys
+            .iter()
+            .copied()
+            .filter(|e| is_feature(s, p, &uses[e]))
+            .collect();
+        let graph = FeatureGraph::new(s.vertices.len(), &edges);
+        let corners = graph.corners(s, p.feature_angle);
+        let polylines = graph.polylines(&corners);
+        let (patch_of, n_patches) = patches(s, &uses, &edges);
+        Features {
+            edges,
+            polylines,
+            corners,
+            patch_of,
+            n_patches,
+        }
+    }
+
+    /// For every corner, its smallest angle between feature curves or spanned by a patch.
+    pub fn corner_angles(&self, s: &InputSurface) -> Vec<CornerAngle> {
+        let graph = FeatureGraph::new(s.vertices.len(), &self.edges);
+        let mut patch_angle: FxHashMap<(u32, u32), f64> = FxHashMap::default();
+        let is_corner = |v: u32| self.corners.binary_search(&v).is_ok();
+        for (t, tri) in s.triangles.iter().enumerate() {
+            for j in 0..3 {
+                let v = tri[j];
+                if is_corner(v) {
+                    let p = s.vertices[v as usize];
+                    let a = s.vertices[tri[(j + 1) % 3] as usize] - p;
+                    let b = s.vertices[tri[(j + 2) % 3] as usize] - p;
+                    *patch_angle.entry((v, self.patch_of[t])).or_default() += angle_deg(a, b);
+                }
+            }
+        }
+        let mut smallest_patch: FxHashMap<u32, f64> = FxHashMap::default();
+        for (&(v, _), &sum) in &patch_angle {
+            let m = smallest_patch.entry(v).or_insert(f64::INFINITY);
+            *m = m.min(sum);
+        }
+        self.corners
+            .iter()
+            .map(|&v| {
+                let p = s.vertices[v as usize];
+                let nb = graph.neighbours(v);
+                let mut angle = f64::INFINITY;
+                for (i, &a) in nb.iter().enumerate() {
+                    for &b in &nb[i + 1..] {
+                        let da = s.vertices[a as usize] - p;
+                        let db = s.vertices[b as usize] - p;
+                        angle = angle.min(angle_deg(da, db));
+                    }
+                }
+                if let Some(&sum) = smallest_patch.get(&v) {
+                    angle = angle.min(sum);
+                }
+                CornerAngle { vertex: v, angle }
+            })
+            .collect()
+    }
+}
+
+/// Feature edges as a vertex adjacency (neighbours sorted ascending).
+struct FeatureGraph {
+    start: Vec<usize>,
+    adjacent: Vec<u32>,
+}
+
+impl FeatureGraph {
+    fn new(n_vertices: usize, edges: &[[u32; 2]]) -> FeatureGraph {
+        let mut degree = vec![0usize; n_vertices + 1];
+        for e in edges {
+            degree[e[0] as usize + 1] += 1;
+            degree[e[1] as usize + 1] += 1;
+        }
+        for i in 1..degree.len() {
+            degree[i] += degree[i - 1];
+        }
+        let start = degree.clone();
+        let mut fill = degree;
+        let mut adjacent = vec![0u32; edges.len() * 2];
+        for e in edges {
+            for (v, w) in [(e[0], e[1]), (e[1], e[0])] {
+                adjacent[fill[v as usize]] = w;
+                fill[v as usize] += 1;
+            }
+        }
+        for v in 0..n_vertices {
+            adjacent[start[v]..start[v + 1]].sort_unstable();
+        }
+        FeatureGraph { start, adjacent }
+    }
+
+    fn neighbours(&self, v: u32) -> &[u32] {
+        &self.adjacent[self.start[v as usize]..self.start[v as usize + 1]]
+    }
+
+    fn corners(&self, s: &InputSurface, feature_angle: f64) -> Vec<u32> {
+        (0..s.vertices.len() as u32)
+            .filter(|&v| match self.neighbours(v) {
+                [] => false,
+                [a, b] => {
+                    let p = s.vertices[v as usize];
+                    let into = p - s.vertices[*a as usize];
+                    let out = s.vertices[*b as usize] - p;
+                    angle_deg(into, out) > feature_angle
+                }
+                _ => true,
+            })
+            .collect()
+    }
+
+    fn polylines(&self, corners: &[u32]) -> Vec<Polyline> {
+        let mut used: FxHashMap<[u32; 2], ()> = FxHashMap::default();
+        let is_corner = |v: u32| corners.binary_search(&v).is_ok();
+        let mut lines = Vec::new();
+        for &c in corners {
+            for &next in self.neighbours(c) {
+                if used.insert(sorted(c, next), ()).is_none() {
+                    let mut vertices = vec![c, next];
+                    self.walk(&mut vertices, &mut used, &is_corner);
+                    lines.push(Polyline {
+                        vertices,
+                        closed: false,
+                    });
+                }
+            }
+        }
+        let n = self.start.len() - 1;
+        for v in 0..n as u32 {
+            for &next in self.neighbours(v) {
+                if used.insert(sorted(v, next), ()).is_none() {
+                    let mut vertices = vec![v, next];
+                    self.walk(&mut vertices, &mut used, &|w| w == v);
+                    vertices.pop();
+                    lines.push(Polyline {
+                        vertices,
+                        closed: true,
+                    });
+                }
+            }
+        }
+        lines
+    }
+
+    /// Extends `vertices` through degree-2 vertices until `stop` holds at its end.
+    fn walk(
+        &self,
+        vertices: &mut Vec<u32>,
+        used: &mut FxHashMap<[u32; 2], ()>,
+        stop: &dyn Fn(u32) -> bool,
+    ) {
+        loop {
+            let v = *vertices.last().expect("a walk starts with an edge");
+            if stop(v) {
+                return;
+            }
+            let next = self
+                .neighbours(v)
+                .iter()
+                .copied()
+                .find(|&w| !used.contains_key(&sorted(v, w)));
+            match next {
+                Some(w) => {
+                    used.insert(sorted(v, w), ());
+                    vertices.push(w);
+                }
+                None => return,
+            }
+        }
+    }
+}
+
+/// Patch of each triangle (flood fill across non-feature edges, seeds in triangle order).
+fn patches(s: &InputSurface, uses: &EdgeUses, feature_edges: &[[u32; 2]]) -> (Vec<u32>, usize) {
+    let n = s.triangles.len();
+    let mut patch_of = vec![u32::MAX; n];
+    let mut n_patches = 0u32;
+    let mut stack = Vec::new();
+    for seed in 0..n {
+        if patch_of[seed] != u32::MAX {
+            continue;
+        }
+        patch_of[seed] = n_patches;
+        stack.push(seed as u32);
+        while let Some(t) = stack.pop() {
+            let tri = s.triangles[t as usize];
+            for j in 0..3 {
+                let e = sorted(tri[j], tri[(j + 1) % 3]);
+                if feature_edges.binary_search(&e).is_ok() {
+                    continue;
+                }
+                for &(u, _) in &uses[&e] {
+                    if patch_of[u as usize] == u32::MAX {
+                        patch_of[u as usize] = n_patches;
+                        stack.push(u);
+                    }
+                }
+            }
+        }
+        n_patches += 1;
+    }
+    (patch_of, n_patches as usize)
+}

@@ -1,0 +1,102 @@
+//! The input surface as a description of a piecewise smooth boundary (groundwork of the
+//! `approximate` surface mode): the triangles of a checked [`Plc`], their sharp features, and a
+//! geometric oracle over them.
+//!
+//! - [`InputSurface`]: every facet triangle of the checked PLC with its facet and marker.
+//! - [`features`]: sharp edges (normals differ by more than a feature angle, labels change,
+//!   non-manifold edges) joined into polylines between corners; smooth patches.
+//! - [`oracle`]: an AABB tree over the triangles: closest point, segment crossings (the exact
+//!   segment/triangle test decides, floating point only places the crossing), inside test by
+//!   ray parity with exact predicates.
+//! - [`distance`]: two-sided Hausdorff distance between two triangle surfaces, by dense
+//!   sampling.
+
+pub mod distance;
+pub mod features;
+pub mod oracle;
+#[cfg(test)]
+mod tests;
+
+use crate::plc::Plc;
+use glam::DVec3;
+
+/// The facet triangles of a checked PLC, in facet order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InputSurface {
+    pub vertices: Vec<DVec3>,
+    /// Counter-clockwise seen from the tip of their facet's normal.
+    pub triangles: Vec<[u32; 3]>,
+    /// Index of the facet each triangle belongs to.
+    pub facet_of: Vec<u32>,
+    /// Marker of that facet.
+    pub marker_of: Vec<i32>,
+}
+
+impl InputSurface {
+    /// Every triangle of every facet of `plc`.
+    pub fn from_plc(plc: &Plc) -> InputSurface {
+        let mut s = InputSurface {
+            vertices: plc.vertices.clone(),
+            triangles: Vec::new(),
+            facet_of: Vec::new(),
+            marker_of: Vec::new(),
+        };
+        for (k, f) in plc.facets.iter().enumerate() {
+            for &t in &f.triangles {
+                s.triangles.push(t);
+                s.facet_of.push(k as u32);
+                s.marker_of.push(f.marker);
+            }
+        }
+        s
+    }
+
+    /// A surface from raw triangles (one facet per triangle, marker 0).
+    pub fn from_triangles(vertices: Vec<DVec3>, triangles: Vec<[u32; 3]>) -> InputSurface {
+        let n = triangles.len();
+        InputSurface {
+            vertices,
+            triangles,
+            facet_of: (0..n as u32).collect(),
+            marker_of: vec![0; n],
+        }
+    }
+
+    /// The corner points of triangle `t`.
+    pub fn corners(&self, t: usize) -> [DVec3; 3] {
+        self.triangles[t].map(|v| self.vertices[v as usize])
+    }
+
+    /// Unit normal of triangle `t` (zero for a degenerate triangle).
+    pub fn normal(&self, t: usize) -> DVec3 {
+        let [a, b, c] = self.corners(t);
+        (b - a).cross(c - a).normalize_or_zero()
+    }
+
+    /// Total area.
+    pub fn area(&self) -> f64 {
+        (0..self.triangles.len())
+            .map(|t| {
+                let [a, b, c] = self.corners(t);
+                0.5 * (b - a).cross(c - a).length()
+            })
+            .sum()
+    }
+
+    /// Length of the diagonal of the bounding box of the vertices used by triangles.
+    pub fn bbox_diagonal(&self) -> f64 {
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for t in &self.triangles {
+            for &v in t {
+                lo = lo.min(self.vertices[v as usize]);
+                hi = hi.max(self.vertices[v as usize]);
+            }
+        }
+        if lo.x > hi.x {
+            0.0
+        } else {
+            (hi - lo).length()
+        }
+    }
+}

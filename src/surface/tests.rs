@@ -1,0 +1,284 @@
+//! Features, oracle and distance on synthetic surfaces with known answers, and on the shared
+//! models against brute force.
+
+use super::distance::{hausdorff, samples};
+use super::features::{FeatureParams, Features};
+use super::oracle::{closest_on_triangle, Side, SurfaceOracle};
+use super::InputSurface;
+use crate::io::{read_plc, ReadOptions};
+use crate::plc::validate;
+use glam::DVec3;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// A closed prism over a regular `n`-gon of radius 1, z in [0, h]; side quads split in two,
+/// caps fanned from their centres. Every triangle is its own facet.
+fn prism(n: usize, h: f64) -> InputSurface {
+    let mut v = Vec::new();
+    for k in 0..n {
+        let a = std::f64::consts::TAU * k as f64 / n as f64;
+        v.push(DVec3::new(a.cos(), a.sin(), 0.0));
+        v.push(DVec3::new(a.cos(), a.sin(), h));
+    }
+    let (bottom, top) = (v.len() as u32, v.len() as u32 + 1);
+    v.push(DVec3::ZERO);
+    v.push(DVec3::new(0.0, 0.0, h));
+    let mut t = Vec::new();
+    for k in 0..n as u32 {
+        let j = (k + 1) % n as u32;
+        let (b0, t0, b1, t1) = (2 * k, 2 * k + 1, 2 * j, 2 * j + 1);
+        t.push([b0, b1, t1]);
+        t.push([b0, t1, t0]);
+        t.push([bottom, b1, b0]);
+        t.push([top, t0, t1]);
+    }
+    InputSurface::from_triangles(v, t)
+}
+
+fn model_surface(rel: &str) -> InputSurface {
+    let path = crate::io::tests::model(rel);
+    let input = read_plc(
+        &path,
+        &ReadOptions {
+            merge_coplanar: true,
+        },
+    )
+    .unwrap();
+    InputSurface::from_plc(&validate(&input).unwrap())
+}
+
+#[test]
+fn cylinder_has_two_closed_rims_and_three_patches() {
+    let s = prism(32, 2.0);
+    let f = Features::detect(&s, &FeatureParams::default());
+    assert_eq!(f.edges.len(), 64, "the two rims");
+    assert!(f.corners.is_empty());
+    assert_eq!(f.polylines.len(), 2);
+    assert!(f
+        .polylines
+        .iter()
+        .all(|l| l.closed && l.vertices.len() == 32));
+    assert_eq!(f.n_patches, 3);
+}
+
+#[test]
+fn hexagonal_prism_edges_are_all_features_at_forty_degrees() {
+    let s = prism(6, 1.0);
+    let f = Features::detect(&s, &FeatureParams::default());
+    // 6 vertical edges (60 deg normal turn) and 12 rim edges; cap fan spokes are flat.
+    assert_eq!(f.edges.len(), 18);
+    assert_eq!(
+        f.corners.len(),
+        12,
+        "every prism vertex has three feature edges"
+    );
+    assert_eq!(f.polylines.len(), 18);
+    assert!(f
+        .polylines
+        .iter()
+        .all(|l| !l.closed && l.vertices.len() == 2));
+    assert_eq!(f.n_patches, 8);
+    // Above 60 degrees the vertical edges are smooth and the rims become closed loops.
+    let loose = FeatureParams {
+        feature_angle: 61.0,
+        ..Default::default()
+    };
+    let g = Features::detect(&s, &loose);
+    assert_eq!(g.edges.len(), 12);
+    // A rim turns by 60 degrees at each vertex, below 61: two closed loops, no corner.
+    assert!(g.corners.is_empty());
+    assert_eq!(g.polylines.len(), 2);
+    assert!(g.polylines.iter().all(|l| l.closed));
+    assert_eq!(g.n_patches, 3);
+}
+
+#[test]
+fn corner_angles_of_a_cube_are_right_angles() {
+    let s = model_surface("off/cube.off");
+    let f = Features::detect(&s, &FeatureParams::default());
+    assert_eq!(f.edges.len(), 12);
+    assert_eq!(f.corners.len(), 8);
+    assert_eq!(f.n_patches, 6);
+    for c in f.corner_angles(&s) {
+        assert!((c.angle - 90.0).abs() < 1e-9, "{c:?}");
+    }
+}
+
+#[test]
+fn markers_split_patches_only_when_asked() {
+    let mut s = prism(32, 2.0);
+    // Label one half of the side wall differently.
+    for t in 0..s.triangles.len() {
+        s.marker_of[t] = i32::from(t < 64);
+    }
+    let plain = Features::detect(&s, &FeatureParams::default());
+    let labelled = Features::detect(
+        &s,
+        &FeatureParams {
+            use_markers: true,
+            ..Default::default()
+        },
+    );
+    assert_eq!(plain.n_patches, 3);
+    assert!(labelled.n_patches > 3);
+    assert!(labelled.edges.len() > plain.edges.len());
+}
+
+#[test]
+fn features_of_every_shared_surface_are_consistent() {
+    for name in ["fandisk", "joint", "rotor", "elephant", "part"] {
+        let s = model_surface(&format!("off/{name}.off"));
+        let f = Features::detect(&s, &FeatureParams::default());
+        // Every feature edge is on exactly one polyline, polylines end at corners.
+        let mut covered = Vec::new();
+        for l in &f.polylines {
+            let n = l.vertices.len();
+            let m = if l.closed { n } else { n - 1 };
+            for i in 0..m {
+                let (a, b) = (l.vertices[i], l.vertices[(i + 1) % n]);
+                covered.push([a.min(b), a.max(b)]);
+            }
+            if !l.closed {
+                for end in [l.vertices[0], l.vertices[n - 1]] {
+                    assert!(f.corners.binary_search(&end).is_ok(), "{name}: open end");
+                }
+            }
+        }
+        covered.sort_unstable();
+        assert_eq!(
+            covered, f.edges,
+            "{name}: polylines cover the feature edges once"
+        );
+        assert!(f.patch_of.iter().all(|&p| (p as usize) < f.n_patches));
+        // Two runs agree (no hash order leaks out).
+        assert_eq!(f, Features::detect(&s, &FeatureParams::default()));
+    }
+}
+
+#[test]
+fn closest_point_matches_brute_force() {
+    let s = model_surface("off/fandisk.off");
+    let o = SurfaceOracle::new(&s);
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let d = s.bbox_diagonal();
+    for _ in 0..300 {
+        let p = DVec3::new(rng.gen(), rng.gen(), rng.gen()) * 2.0 * d - DVec3::splat(d / 2.0);
+        let fast = o.closest(p).unwrap();
+        let brute = (0..s.triangles.len())
+            .map(|t| {
+                let [a, b, c] = s.corners(t);
+                (closest_on_triangle(p, a, b, c) - p).length()
+            })
+            .fold(f64::INFINITY, f64::min);
+        assert!((fast.distance - brute).abs() <= 1e-12 * d, "{p}");
+    }
+}
+
+#[test]
+fn segment_crossings_match_brute_force() {
+    let s = model_surface("off/joint.off");
+    let o = SurfaceOracle::new(&s);
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let d = s.bbox_diagonal();
+    let lo = s
+        .vertices
+        .iter()
+        .fold(DVec3::splat(f64::INFINITY), |m, v| m.min(*v));
+    for _ in 0..200 {
+        let mut pick = || lo + DVec3::new(rng.gen(), rng.gen(), rng.gen()) * d * 0.6;
+        let (p, q) = (pick(), pick());
+        let mut fast: Vec<u32> = o.crossings(p, q).iter().map(|c| c.triangle).collect();
+        fast.sort_unstable();
+        let brute: Vec<u32> = (0..s.triangles.len() as u32)
+            .filter(|&t| {
+                let [a, b, c] = s.corners(t as usize);
+                crate::plc::exact::segment_meets_triangle(p, q, a, b, c)
+            })
+            .collect();
+        assert_eq!(fast, brute);
+        for c in o.crossings(p, q) {
+            let [a, b, cc] = s.corners(c.triangle as usize);
+            let gap = (closest_on_triangle(c.point, a, b, cc) - c.point).length();
+            assert!(gap <= 1e-9 * d, "crossing point off its triangle by {gap}");
+        }
+    }
+}
+
+#[test]
+fn inside_test_on_a_cylinder_and_a_model() {
+    let s = prism(64, 2.0);
+    let o = SurfaceOracle::new(&s);
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let inradius = (std::f64::consts::PI / 64.0).cos();
+    for _ in 0..2000 {
+        let p = DVec3::new(
+            rng.gen_range(-1.5..1.5),
+            rng.gen_range(-1.5..1.5),
+            rng.gen_range(-0.5..2.5),
+        );
+        let r = p.truncate().length();
+        let inside = r < inradius - 1e-6 && p.z > 1e-6 && p.z < 2.0 - 1e-6;
+        let outside = r > 1.0 + 1e-6 || p.z < -1e-6 || p.z > 2.0 + 1e-6;
+        match o.side(p) {
+            Side::Inside => assert!(!outside, "{p} is outside"),
+            Side::Outside => assert!(!inside, "{p} is inside"),
+            Side::OnSurface => panic!("{p} is not on the surface"),
+        }
+    }
+    // Vertices, edge midpoints and the axis through the cap centres (all degenerate for
+    // axis-aligned rays) are classified.
+    assert_eq!(o.side(s.vertices[0]), Side::OnSurface);
+    assert_eq!(
+        o.side((s.vertices[0] + s.vertices[1]) / 2.0),
+        Side::OnSurface
+    );
+    assert_eq!(o.side(DVec3::new(0.0, 0.0, 1.0)), Side::Inside);
+    assert_eq!(o.side(DVec3::new(0.0, 0.0, 3.0)), Side::Outside);
+
+    // On a model: agree with the parity of a second, independent ray family (the closest
+    // point's side is not usable: facet orientation is arbitrary), tested on the cube.
+    let cube = model_surface("off/cube.off");
+    let oc = SurfaceOracle::new(&cube);
+    let lo = cube
+        .vertices
+        .iter()
+        .fold(DVec3::splat(f64::INFINITY), |m, v| m.min(*v));
+    let hi = cube
+        .vertices
+        .iter()
+        .fold(DVec3::splat(f64::NEG_INFINITY), |m, v| m.max(*v));
+    assert_eq!(oc.side((lo + hi) / 2.0), Side::Inside);
+    assert_eq!(oc.side(hi + (hi - lo)), Side::Outside);
+    assert_eq!(oc.side(lo), Side::OnSurface);
+    // A face centre: on a facet diagonal shared by two triangles.
+    assert_eq!(
+        oc.side(DVec3::new(lo.x, (lo.y + hi.y) / 2.0, (lo.z + hi.z) / 2.0)),
+        Side::OnSurface
+    );
+}
+
+#[test]
+fn hausdorff_of_known_shapes() {
+    let a = prism(16, 1.0);
+    assert!(hausdorff(&a, &a, 0.05).max() < 1e-12);
+    // The same prism lifted by 0.25: every point moves 0.25, the nearest point of the other
+    // is no farther than that.
+    let mut b = a.clone();
+    for v in &mut b.vertices {
+        v.z += 0.25;
+    }
+    let h = hausdorff(&a, &b, 0.02);
+    assert!((h.a_to_b - 0.25).abs() < 1e-12, "{h:?}");
+    assert!((h.b_to_a - 0.25).abs() < 1e-12, "{h:?}");
+    // Sampling is dense enough: every triangle's centroid is within spacing of a sample.
+    let pts = samples(&a, 0.1);
+    for t in 0..a.triangles.len() {
+        let [p, q, r] = a.corners(t);
+        let c = (p + q + r) / 3.0;
+        let near = pts
+            .iter()
+            .map(|s| (*s - c).length())
+            .fold(f64::INFINITY, f64::min);
+        assert!(near <= 0.1);
+    }
+}
