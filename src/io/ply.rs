@@ -67,6 +67,19 @@ impl Scalar {
         }
     }
 
+    fn name(self) -> &'static str {
+        match self {
+            Scalar::I8 => "char",
+            Scalar::U8 => "uchar",
+            Scalar::I16 => "short",
+            Scalar::U16 => "ushort",
+            Scalar::I32 => "int",
+            Scalar::U32 => "uint",
+            Scalar::F32 => "float",
+            Scalar::F64 => "double",
+        }
+    }
+
     fn is_int(self) -> bool {
         !matches!(self, Scalar::F32 | Scalar::F64)
     }
@@ -284,7 +297,7 @@ impl Body<'_> {
                 if !in_range(ty, v) {
                     return Err(err_at(
                         line,
-                        format!("{} = {w} does not fit its type ({ty:?})", at.what()),
+                        format!("{} = {w} does not fit its type {}", at.what(), ty.name()),
                     ));
                 }
                 Ok(v)

@@ -194,7 +194,7 @@ fn malformed_ply_files() {
     expect_err(
         &body("0 0 0\n1 0 0\n0 1 0\n256 0 1 2\n"),
         Some(13),
-        "does not fit its type",
+        "does not fit its type uchar",
     );
     expect_err(
         &body("0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n5\n"),
