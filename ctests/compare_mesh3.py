@@ -187,7 +187,7 @@ def main():
     ap.add_argument("--slivermesh", default=os.path.join(here, "..", "target", "release", "slivermesh"))
     ap.add_argument("--cgal-mesh3", default=os.path.join(here, "..", "build", "ctests", "cgal_mesh3"))
     ap.add_argument("--input", action="append",
-                    help="an .off model (repeatable; default: off/cube.off and off/cross.off of the shared models)")
+                    help="an .off model (repeatable; default: off/cube.off and off/cross.off of models/)")
     ap.add_argument("--tets", type=int, default=4000, help="target number of tets (default 4000)")
     ap.add_argument("--repeat", type=int, default=1, help="timed runs per program, fastest kept (default 1)")
     ap.add_argument("--tol", type=float, default=0.05,
@@ -202,10 +202,8 @@ def main():
     args = ap.parse_args()
 
     if not args.input:
-        for models in (os.path.join(here, "..", "..", "shared", "models"), "/work/shared/models"):
-            if os.path.isdir(models):
-                args.input = [os.path.abspath(os.path.join(models, "off", m)) for m in ("cube.off", "cross.off")]
-                break
+        models = os.path.join(here, "..", "models", "off")
+        args.input = [os.path.abspath(os.path.join(models, m)) for m in ("cube.off", "cross.off")]
     for m in args.input or [None]:
         if not m or not os.path.isfile(m):
             print("error: input model not found: %s" % m, file=sys.stderr)

@@ -216,7 +216,7 @@ def main():
     ap.add_argument("--slivermesh", default=os.path.join(here, "..", "target", "release", "slivermesh"))
     ap.add_argument("--tetgen", default=shutil.which("tetgen") or "/usr/bin/tetgen")
     ap.add_argument("--input", default=None,
-                    help="a .poly (or .off/.stl) both programs read (default: ../../shared/models/poly/cube.poly)")
+                    help="a .poly (or .off/.stl) both programs read (default: models/poly/cube.poly)")
     ap.add_argument("--tets", type=int, default=20000, help="target number of tets (default 20000)")
     ap.add_argument("--quality", default="1.414", help="tetgen's -q radius-edge bound (default 1.414)")
     ap.add_argument("--repeat", type=int, default=3, help="timed runs per program, best kept (default 3)")
@@ -232,11 +232,7 @@ def main():
     args = ap.parse_args()
 
     if args.input is None:
-        for cand in (os.path.join(here, "..", "..", "shared", "models", "poly", "cube.poly"),
-                     "/work/shared/models/poly/cube.poly"):
-            if os.path.isfile(cand):
-                args.input = os.path.abspath(cand)
-                break
+        args.input = os.path.abspath(os.path.join(here, "..", "models", "poly", "cube.poly"))
     if not args.input or not os.path.isfile(args.input):
         print("error: input .poly not found: %s" % args.input, file=sys.stderr)
         return 2

@@ -11,7 +11,7 @@ fn main() {
     let size: f64 = std::env::args()
         .nth(1)
         .map_or(0.08, |s| s.parse().expect("size"));
-    let models = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/models");
+    let models = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models");
     let inputs = [
         "poly/cube.poly",
         "poly/lshape.poly",

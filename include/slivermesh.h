@@ -36,6 +36,23 @@
 #include <stdint.h>
 
 /**
+ * Major version of the header (the library's is in sm_version()). From 1.0 on, the ABI may
+ * break only when this changes; the shared library's SONAME is libslivermesh.so.MAJOR.
+ */
+#define SM_VERSION_MAJOR 0
+
+/**
+ * Minor version of the header. While MAJOR is 0 a new minor version may break the ABI, so the
+ * SONAME is libslivermesh.so.0.MINOR.
+ */
+#define SM_VERSION_MINOR 1
+
+/**
+ * Patch version of the header.
+ */
+#define SM_VERSION_PATCH 0
+
+/**
  * An opaque mesher: a domain, parameters, a spacing, callbacks, and after `sm_refine` a mesh.
  *
  * Created by `sm_create`, freed by `sm_destroy`. Handles are independent: different handles may
@@ -227,7 +244,8 @@ void sm_destroy(sm_mesher *m);
 const char *sm_last_error(const sm_mesher *m);
 
 /**
- * The library version ("MAJOR.MINOR.PATCH"), a static string.
+ * The library version ("MAJOR.MINOR.PATCH", the SM_VERSION_* of the header it was built with),
+ * a static string.
  */
 const char *sm_version(void);
 

@@ -6,7 +6,11 @@
 #   scripts/install.sh PREFIX --lib-dir DIR   # take the libraries from DIR (e.g. target/debug)
 #
 # Installs
-#   PREFIX/lib/libslivermesh.so, PREFIX/lib/libslivermesh.a
+#   PREFIX/lib/libslivermesh.so.MAJOR.MINOR.PATCH   (the shared library; its SONAME is
+#                                          libslivermesh.so.0.MINOR for 0.x, .so.MAJOR from 1.0)
+#   PREFIX/lib/libslivermesh.so.0.MINOR -> it     (the SONAME link, what programs load)
+#   PREFIX/lib/libslivermesh.so -> the SONAME link (for linking with -lslivermesh)
+#   PREFIX/lib/libslivermesh.a
 #   PREFIX/include/slivermesh.h            (the C/C++ header)
 #   PREFIX/include/slivermesh.f90          (the Fortran interface module, as source)
 #   PREFIX/lib/cmake/SliverMesh/SliverMeshConfig.cmake, SliverMeshConfigVersion.cmake
@@ -16,7 +20,7 @@
 set -euo pipefail
 
 usage() {
-  sed -n '2,9p' "$0" | sed 's/^# \{0,1\}//' >&2
+  sed -n '2,6p' "$0" | sed 's/^# \{0,1\}//' >&2
   exit 2
 }
 
@@ -63,14 +67,31 @@ version="$(sed -n 's/^version *= *"\([^"]*\)".*/\1/p' "$root/Cargo.toml" | head 
 sizeof_void_p="$(getconf LONG_BIT 2>/dev/null || echo 64)"
 sizeof_void_p=$((sizeof_void_p / 8))
 
+# The SONAME rule of build.rs; the library must carry it (an older build has none).
+IFS=. read -r major minor _ <<<"$version"
+if [[ "$major" == 0 ]]; then soname="libslivermesh.so.0.$minor"; else soname="libslivermesh.so.$major"; fi
+real="libslivermesh.so.${version%%[-+]*}"
+if command -v objdump >/dev/null; then
+  found="$(objdump -p "$lib_dir/libslivermesh.so" | sed -n 's/^ *SONAME *//p')"
+  if [[ "$found" != "$soname" ]]; then
+    echo "install.sh: $lib_dir/libslivermesh.so has SONAME '${found:-none}', expected $soname" \
+      "(rebuild with: cargo build --release --lib)" >&2
+    exit 1
+  fi
+fi
+
 mkdir -p "$prefix"
 prefix="$(cd "$prefix" && pwd)"
 cmake_dir="$prefix/lib/cmake/SliverMesh"
 install -d "$prefix/lib" "$prefix/include" "$cmake_dir" "$prefix/lib/pkgconfig"
-install -m 755 "$lib_dir/libslivermesh.so" "$prefix/lib/"
+rm -f "$prefix/lib/libslivermesh.so" "$prefix/lib/$soname"
+install -m 755 "$lib_dir/libslivermesh.so" "$prefix/lib/$real"
+ln -s "$real" "$prefix/lib/$soname"
+ln -s "$soname" "$prefix/lib/libslivermesh.so"
 install -m 644 "$lib_dir/libslivermesh.a" "$prefix/lib/"
 install -m 644 "$root/include/slivermesh.h" "$root/include/slivermesh.f90" "$prefix/include/"
-install -m 644 "$root/cmake/SliverMeshConfig.cmake" "$cmake_dir/"
+sed -e "s|@SLIVERMESH_SONAME@|$soname|g" -e "s|@SLIVERMESH_LIBRARY@|$real|g" \
+  "$root/cmake/SliverMeshConfig.cmake.in" >"$cmake_dir/SliverMeshConfig.cmake"
 sed -e "s|@SLIVERMESH_VERSION@|$version|g" -e "s|@SLIVERMESH_SIZEOF_VOID_P@|$sizeof_void_p|g" \
   "$root/cmake/SliverMeshConfigVersion.cmake.in" >"$cmake_dir/SliverMeshConfigVersion.cmake"
 sed -e "s|@PREFIX@|$prefix|g" -e "s|@SLIVERMESH_VERSION@|$version|g" \

@@ -40,8 +40,9 @@ enum Command {
         #[arg(long, value_name = "FILE")]
         stats_json: Option<PathBuf>,
     },
-    /// Mesh a domain (.poly, .smesh, .off, .stl) with quality refinement, or remove the slivers
-    /// of an existing mesh (.mesh). Output format by extension (.vtu, .mesh, .msh, .node/.ele).
+    /// Mesh a domain (.poly, .smesh, .off, .stl, .ply, .obj) with quality refinement, or remove the
+    /// slivers of an existing mesh (.mesh). Output format by extension (.vtu, .mesh, .msh,
+    /// .node/.ele).
     Mesh {
         /// Input domain or existing mesh.
         input: PathBuf,

@@ -1,11 +1,11 @@
-//! Boundary-conforming Delaunay meshes of every model in ../shared/models (issue 3), and
+//! Boundary-conforming Delaunay meshes of every model in models/ (issue 3), and
 //! quality refinement on the acute-free ones (issue 4).
 
 mod common;
 use common::*;
 use slivermesh::refine::{mesh, Params};
 
-/// Expected volumes (../shared/models/README.md).
+/// Expected volumes (models/README.md).
 const POLY: &[(&str, f64)] = &[
     ("poly/cube.poly", 1.0),
     ("poly/lshape.poly", 3.0),

@@ -32,7 +32,7 @@ if [[ -n "$fc" ]]; then
   programs+=("$work/fortran/cube_f")
 fi
 
-# The shared build must load the installed library (cargo sets no SONAME).
+# The shared build must load the installed library (through its SONAME link).
 if ! ldd "$work/c-shared/cube_c" | grep -q "$prefix/lib/libslivermesh.so"; then
   echo "c-shared does not load $prefix/lib/libslivermesh.so:"
   ldd "$work/c-shared/cube_c"

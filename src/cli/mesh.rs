@@ -40,7 +40,7 @@ pub struct MeshOptions {
     /// next to small angles for more vertices and time.
     #[arg(long, value_name = "K")]
     pub small_angle_reach: Option<f64>,
-    /// Keep .off/.stl triangles as separate facets instead of merging coplanar ones.
+    /// Keep .off/.stl/.ply/.obj faces as separate facets instead of merging coplanar ones.
     #[arg(long)]
     pub no_merge: bool,
 }
@@ -73,7 +73,8 @@ impl MeshOptions {
     }
 }
 
-/// Meshes `input` (.poly/.smesh/.off/.stl, or an existing .mesh whose slivers are removed).
+/// Meshes `input` (.poly/.smesh/.off/.stl/.ply/.obj, or an existing .mesh whose slivers are
+/// removed).
 pub fn run_mesh(
     input: &Path,
     output: Option<&Path>,
@@ -91,10 +92,7 @@ pub fn run_mesh(
         let existing = io::read_mesh(input).map_err(|e| e.to_string())?;
         refine::existing::remove_slivers(&existing, &params).map_err(|e| e.to_string())?
     } else {
-        let merge = !opts.no_merge
-            && input
-                .extension()
-                .is_some_and(|e| e.eq_ignore_ascii_case("off") || e.eq_ignore_ascii_case("stl"));
+        let merge = !opts.no_merge && io::is_surface_file(input);
         let plc = io::read_plc(
             input,
             &ReadOptions {

@@ -120,7 +120,17 @@ pub unsafe extern "C" fn sm_last_error(m: *const sm_mesher) -> *const c_char {
     })
 }
 
-/// The library version ("MAJOR.MINOR.PATCH"), a static string.
+/// Major version of the header (the library's is in sm_version()). From 1.0 on, the ABI may
+/// break only when this changes; the shared library's SONAME is libslivermesh.so.MAJOR.
+pub const SM_VERSION_MAJOR: u32 = 0;
+/// Minor version of the header. While MAJOR is 0 a new minor version may break the ABI, so the
+/// SONAME is libslivermesh.so.0.MINOR.
+pub const SM_VERSION_MINOR: u32 = 1;
+/// Patch version of the header.
+pub const SM_VERSION_PATCH: u32 = 0;
+
+/// The library version ("MAJOR.MINOR.PATCH", the SM_VERSION_* of the header it was built with),
+/// a static string.
 #[no_mangle]
 pub extern "C" fn sm_version() -> *const c_char {
     const VERSION: &CStr =

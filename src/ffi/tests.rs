@@ -111,6 +111,31 @@ fn status_codes_are_fixed_and_described() {
     assert_eq!(text(sm_status_str(-1)), "unknown status");
     assert_eq!(text(sm_status_str(999)), "unknown status");
     assert_eq!(text(sm_version()), env!("CARGO_PKG_VERSION"));
+}
+
+/// The header's SM_VERSION_* macros, sm_version() and Cargo.toml agree (bump all three together).
+#[test]
+fn version_macros_match_the_library() {
+    let macros = format!("{SM_VERSION_MAJOR}.{SM_VERSION_MINOR}.{SM_VERSION_PATCH}");
+    assert_eq!(
+        macros,
+        env!("CARGO_PKG_VERSION"),
+        "SM_VERSION_* in src/ffi/mesher.rs vs Cargo.toml"
+    );
+    assert_eq!(text(sm_version()), macros);
+    let header =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/include/slivermesh.h"))
+            .unwrap();
+    for (name, v) in [
+        ("SM_VERSION_MAJOR", SM_VERSION_MAJOR),
+        ("SM_VERSION_MINOR", SM_VERSION_MINOR),
+        ("SM_VERSION_PATCH", SM_VERSION_PATCH),
+    ] {
+        assert!(
+            header.contains(&format!("#define {name} {v}\n")),
+            "include/slivermesh.h lacks `#define {name} {v}`"
+        );
+    }
     // include/slivermesh.f90 mirrors sm_quality field by field and checks this size too.
     assert_eq!(std::mem::size_of::<sm_quality>(), 168);
 }

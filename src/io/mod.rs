@@ -7,6 +7,8 @@
 //! | TetGen `.poly`, `.smesh` (+ `.node`) | domain ([`PlcInput`]) | | [`poly`] |
 //! | `.off` | domain | | [`off`] |
 //! | `.stl` (ASCII, binary) | domain | | [`stl`] |
+//! | `.ply` (ASCII, binary either endian) | domain | | [`ply`] |
+//! | Wavefront `.obj` | domain | | [`obj`] |
 //! | medit `.mesh` | mesh ([`TetMesh`]) | mesh | [`medit`] |
 //! | VTK `.vtu` | mesh + cell fields | mesh + cell fields | [`vtu`] |
 //! | gmsh `.msh` 4.1 | mesh | mesh | [`gmsh`] |
@@ -15,8 +17,8 @@
 //! [`read_plc`], [`read_mesh`] and [`write_mesh`] choose the format by extension
 //! (case-insensitive). Errors are [`IoError`]s naming the file and, for text formats, the
 //! 1-based line. Floats are written in shortest round-trip form, so a written mesh reads back
-//! bit for bit. Marker conventions: a `.poly`/`.smesh` facet without a marker gets 1; `.off`
-//! and `.stl` facets get their 1-based facet index (after the optional coplanar merge); mesh
+//! bit for bit. Marker conventions: a `.poly`/`.smesh` facet without a marker gets 1; `.off`,
+//! `.stl`, `.ply` and `.obj` facets get their 1-based facet index (after the optional coplanar merge); mesh
 //! readers use 0 for a missing region or marker.
 
 use crate::mesh::TetMesh;
@@ -26,7 +28,9 @@ use std::path::Path;
 pub use crate::plc::coplanar;
 pub mod gmsh;
 pub mod medit;
+pub mod obj;
 pub mod off;
+pub mod ply;
 pub mod points;
 pub mod poly;
 pub mod stl;
@@ -65,12 +69,23 @@ pub struct CellField<'a> {
 /// Options for reading domain files.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct ReadOptions {
-    /// Merge coplanar neighbouring triangles of .off/.stl surfaces into polygon facets.
+    /// Merge coplanar neighbouring faces of surface formats ([`SURFACE_EXTENSIONS`]) into
+    /// polygon facets.
     pub merge_coplanar: bool,
 }
 
 /// Extensions accepted by [`read_plc`].
-pub const PLC_EXTENSIONS: &[&str] = &["poly", "smesh", "off", "stl"];
+pub const PLC_EXTENSIONS: &[&str] = &["poly", "smesh", "off", "stl", "ply", "obj"];
+/// The [`PLC_EXTENSIONS`] that hold bare surfaces (one facet per face, no markers), whose
+/// coplanar faces are usually merged.
+pub const SURFACE_EXTENSIONS: &[&str] = &["off", "stl", "ply", "obj"];
+
+/// True if `path` has one of the [`SURFACE_EXTENSIONS`] (case-insensitive).
+pub fn is_surface_file(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| SURFACE_EXTENSIONS.iter().any(|s| e.eq_ignore_ascii_case(s)))
+}
 /// Extensions accepted by [`write_mesh`] and [`read_mesh`].
 pub const MESH_EXTENSIONS: &[&str] = &["vtu", "mesh", "msh", "node", "ele", "face"];
 
@@ -101,12 +116,14 @@ fn extension(path: &Path, supported: &[&str], what: &str) -> Result<String, IoEr
     })
 }
 
-/// Reads a domain (.poly, .smesh, .off, .stl), format chosen by extension.
+/// Reads a domain (.poly, .smesh, .off, .stl, .ply, .obj), format chosen by extension.
 pub fn read_plc(path: &Path, options: &ReadOptions) -> Result<PlcInput, IoError> {
     match extension(path, PLC_EXTENSIONS, "domain")?.as_str() {
         "poly" => poly::read_poly(path),
         "smesh" => poly::read_smesh(path),
         "off" => off::read_off(path, options),
+        "ply" => ply::read_ply(path, options),
+        "obj" => obj::read_obj(path, options),
         _ => stl::read_stl(path, options),
     }
 }

@@ -94,13 +94,21 @@ pub(crate) struct Lines<'a> {
     inner: std::iter::Enumerate<std::str::Lines<'a>>,
     /// Number of the last line handed out (0 before the first).
     last: usize,
+    /// Lines before `text` in its file (a body after a header parsed separately).
+    offset: usize,
 }
 
 impl<'a> Lines<'a> {
     pub(crate) fn new(text: &'a str) -> Self {
+        Self::after(text, 0)
+    }
+
+    /// Lines of a text that starts after line `offset` of its file.
+    pub(crate) fn after(text: &'a str, offset: usize) -> Self {
         Lines {
             inner: text.lines().enumerate(),
-            last: 0,
+            last: offset,
+            offset,
         }
     }
 
@@ -109,9 +117,9 @@ impl<'a> Lines<'a> {
         for (i, raw) in self.inner.by_ref() {
             let content = strip_comment(raw);
             if !content.trim().is_empty() {
-                self.last = i + 1;
+                self.last = self.offset + i + 1;
                 return Some(Record {
-                    line: i + 1,
+                    line: self.last,
                     fields: content.split_whitespace(),
                 });
             }
@@ -242,8 +250,12 @@ pub(crate) struct Tokens<'a> {
 
 impl<'a> Tokens<'a> {
     pub(crate) fn new(text: &'a str) -> Self {
+        Self::of_lines(Lines::new(text))
+    }
+
+    pub(crate) fn of_lines(lines: Lines<'a>) -> Self {
         Tokens {
-            lines: Lines::new(text),
+            lines,
             current: None,
         }
     }
@@ -263,6 +275,16 @@ impl<'a> Tokens<'a> {
     /// The next token; end of file is an error naming what was expected.
     pub(crate) fn next(&mut self, what: &str) -> Result<(usize, &'a str), IoError> {
         self.next_opt().ok_or_else(|| self.lines.eof(what))
+    }
+
+    /// The line of the last token handed out.
+    pub(crate) fn line(&self) -> Option<usize> {
+        self.current.as_ref().map(|r| r.line)
+    }
+
+    /// An "unexpected end of file" error naming what was expected.
+    pub(crate) fn eof(&self, what: &str) -> IoError {
+        self.lines.eof(what)
     }
 
     /// Drops the rest of the current line (e.g. a solid's name in STL).

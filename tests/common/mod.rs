@@ -8,13 +8,9 @@ use slivermesh::DVec3;
 use std::collections::HashMap;
 use std::path::PathBuf;
 
+/// The test models, kept in the repository (`models/`, see its README).
 pub fn models_dir() -> PathBuf {
-    let here = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/models");
-    if here.exists() {
-        here
-    } else {
-        PathBuf::from("/work/shared/models")
-    }
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models")
 }
 
 pub fn read_model(rel: &str) -> PlcInput {

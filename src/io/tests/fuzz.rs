@@ -40,7 +40,7 @@ const NASTY: &[&[u8]] = &[
 ];
 
 /// Truncations at up to `cuts` places plus `mutations` random edits, each fed to `parse`.
-fn hammer(data: &[u8], cuts: usize, mutations: usize, seed: u64, parse: &dyn Fn(&[u8])) {
+pub(super) fn hammer(data: &[u8], cuts: usize, mutations: usize, seed: u64, parse: &dyn Fn(&[u8])) {
     parse(data);
     let step = (data.len() / cuts.max(1)).max(1);
     for cut in (0..data.len()).step_by(step) {

@@ -1,19 +1,16 @@
-//! Tests across formats: every shared model reads, every writer round-trips, and no reader
+//! Tests across formats: every model in models/ reads, every writer round-trips, and no reader
 //! panics on damaged input.
 
 mod fuzz;
 mod models;
 mod roundtrip;
+mod surface;
 
 use std::path::{Path, PathBuf};
 
-/// The shared test models: `$CARGO_MANIFEST_DIR/../shared/models`, else `/work/shared/models`.
+/// The test models, kept in the repository (`models/`, see its README).
 pub(crate) fn models_dir() -> PathBuf {
-    let here = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/models");
-    if here.is_dir() {
-        return here;
-    }
-    PathBuf::from("/work/shared/models")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("models")
 }
 
 /// A model file by its path under the models directory (e.g. `poly/cube.poly`).

@@ -1,4 +1,4 @@
-//! Every model in the shared models directory reads, with the expected counts.
+//! Every model in models/ reads, with the expected counts.
 
 use super::{model, models_in, TempDir};
 use crate::io::{read_plc, ReadOptions};
@@ -291,9 +291,12 @@ fn stl_of_cube_off_reads_like_the_off() {
 
 #[test]
 fn unknown_extension_lists_supported_ones() {
-    let e = read_plc(std::path::Path::new("x.obj"), &plain()).unwrap_err();
-    assert!(e.message.contains(".poly, .smesh, .off, .stl"), "{e}");
-    assert!(e.message.contains("'.obj'"), "{e}");
+    let e = read_plc(std::path::Path::new("x.3ds"), &plain()).unwrap_err();
+    assert!(
+        e.message.contains(".poly, .smesh, .off, .stl, .ply, .obj"),
+        "{e}"
+    );
+    assert!(e.message.contains("'.3ds'"), "{e}");
     let e = read_plc(std::path::Path::new("noext"), &plain()).unwrap_err();
     assert!(e.message.contains("no extension"), "{e}");
     let e = read_plc(&model("poly/missing.poly"), &plain()).unwrap_err();

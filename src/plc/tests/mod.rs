@@ -10,14 +10,9 @@ use std::path::PathBuf;
 mod errors;
 mod models;
 
-/// The shared models directory: beside the crate, else the fixed workplace path.
+/// The test models, kept in the repository (`models/`, see its README).
 pub fn models_dir() -> PathBuf {
-    let beside = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/models");
-    if beside.is_dir() {
-        beside
-    } else {
-        PathBuf::from("/work/shared/models")
-    }
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models")
 }
 
 /// Whitespace tokens of the non-comment lines.

@@ -1,4 +1,4 @@
-//! Every shared model validates and gives its known volume and area; structural checks on the
+//! Every model in models/ validates and gives its known volume and area; structural checks on the
 //! ones with holes, cavities and regions.
 
 use super::super::{validate, CellKind, Plc, PlcInput};
