@@ -41,28 +41,36 @@ fn esc(s: &str) -> String {
     o
 }
 
-/// A "nice" tick step (1, 2 or 5 times a power of ten) for about five ticks up to `max`.
-fn tick_step(max: f64) -> f64 {
-    let raw = (max / 5.0).max(1.0);
+/// A "nice" tick step (1, 2 or 5 times a power of ten) for about five ticks up to `max`, at
+/// least `min_step`.
+fn tick_step(max: f64, min_step: f64) -> f64 {
+    let raw = (max / 5.0).max(min_step);
     let p = 10f64.powf(raw.log10().floor());
     [1.0, 2.0, 5.0, 10.0]
         .iter()
         .map(|m| m * p)
-        .find(|&s| s >= raw)
+        .find(|&s| s >= raw * (1.0 - 1e-12))
         .unwrap_or(10.0 * p)
 }
 
-/// The picture of one or two meshes (the first as bars, the second as an outline).
+/// The picture of one or two meshes (the first as bars, the second as an outline). One mesh is
+/// drawn in angle counts; two are drawn in shares of their angles (%), so meshes of different
+/// sizes compare.
 pub fn svg(title: &str, series: &[SvgSeries]) -> String {
     let (pw, ph) = (W - LEFT - RIGHT, H - TOP - BOTTOM);
-    let max = series
+    let share = series.len() > 1;
+    let values: Vec<Vec<f64>> = series
         .iter()
-        .flat_map(|s| s.bins.iter().copied())
-        .max()
-        .unwrap_or(0)
-        .max(1) as f64;
-    let step = tick_step(max);
-    let ymax = (max / step).ceil() * step;
+        .map(|s| {
+            let total = s.bins.iter().sum::<usize>().max(1) as f64;
+            let scale = if share { 100.0 / total } else { 1.0 };
+            s.bins.iter().map(|&c| c as f64 * scale).collect()
+        })
+        .collect();
+    let max = values.iter().flatten().copied().fold(0.0, f64::max);
+    let step = tick_step(max.max(1e-9), if share { 1e-3 } else { 1.0 });
+    let ymax = (max / step).ceil().max(1.0) * step;
+    let decimals = (-step.log10().floor()).max(0.0) as usize;
     let x = |deg: f64| LEFT + deg / 180.0 * pw;
     let y = |count: f64| TOP + ph - count / ymax * ph;
     let mut s = String::new();
@@ -81,17 +89,16 @@ pub fn svg(title: &str, series: &[SvgSeries]) -> String {
         esc(title)
     );
     // Axes, grid and ticks.
-    let mut k = 0.0;
-    while k <= ymax + 0.5 * step {
+    for i in 0..=(ymax / step).round() as usize {
+        let k = i as f64 * step;
         let yy = y(k);
         let _ = writeln!(
             o,
-            "<line x1=\"{LEFT}\" y1=\"{yy:.1}\" x2=\"{:.1}\" y2=\"{yy:.1}\" stroke=\"#e0e0e0\"/>\n<text x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"end\">{k}</text>",
+            "<line x1=\"{LEFT}\" y1=\"{yy:.1}\" x2=\"{:.1}\" y2=\"{yy:.1}\" stroke=\"#e0e0e0\"/>\n<text x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"end\">{k:.decimals$}</text>",
             LEFT + pw,
             LEFT - 6.0,
             yy + 4.0
         );
-        k += step;
     }
     for deg in (0..=180).step_by(10) {
         let xx = x(deg as f64);
@@ -111,14 +118,19 @@ pub fn svg(title: &str, series: &[SvgSeries]) -> String {
     );
     let _ = writeln!(
         o,
-        "<text transform=\"translate(18 {:.1}) rotate(-90)\" text-anchor=\"middle\">angles (6 per tet)</text>",
-        TOP + ph / 2.0
+        "<text transform=\"translate(18 {:.1}) rotate(-90)\" text-anchor=\"middle\">{}</text>",
+        TOP + ph / 2.0,
+        if share {
+            "share of each mesh's angles (%)"
+        } else {
+            "angles (6 per tet)"
+        }
     );
     // First mesh: bars; a non-empty bin is at least a pixel tall so lone bad angles show.
     if let Some(first) = series.first() {
         let _ = writeln!(o, r#"<g id="bars" fill="{}">"#, COLOURS[0]);
         for (i, &c) in first.bins.iter().enumerate().filter(|(_, &c)| c > 0) {
-            let h = (ph - (y(c as f64) - TOP)).max(1.0);
+            let h = (ph - (y(values[0][i]) - TOP)).max(1.0);
             let _ = writeln!(
                 o,
                 "<rect class=\"bar\" x=\"{:.2}\" y=\"{:.2}\" width=\"{:.2}\" height=\"{h:.2}\"><title>{i}-{} deg: {c}</title></rect>",
@@ -133,8 +145,8 @@ pub fn svg(title: &str, series: &[SvgSeries]) -> String {
     // Second mesh: a step outline.
     if let Some(second) = series.get(1) {
         let mut pts = format!("{:.2},{:.2}", x(0.0), y(0.0));
-        for (i, &c) in second.bins.iter().enumerate() {
-            let yy = y(c as f64);
+        for i in 0..second.bins.len() {
+            let yy = y(values[1][i]);
             let _ = write!(
                 pts,
                 " {:.2},{yy:.2} {:.2},{yy:.2}",
