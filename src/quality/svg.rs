@@ -143,10 +143,10 @@ pub fn svg(title: &str, series: &[SvgSeries]) -> String {
         let _ = writeln!(o, "</g>");
     }
     // Second mesh: a step outline.
-    if let Some(second) = series.get(1) {
+    if series.len() > 1 {
         let mut pts = format!("{:.2},{:.2}", x(0.0), y(0.0));
-        for i in 0..second.bins.len() {
-            let yy = y(values[1][i]);
+        for (i, &v) in values[1].iter().enumerate() {
+            let yy = y(v);
             let _ = write!(
                 pts,
                 " {:.2},{yy:.2} {:.2},{yy:.2}",
@@ -195,7 +195,7 @@ fn legend(o: &mut String, series: &[SvgSeries], right: f64, top: f64) {
         let swatch = if k == 0 {
             format!(
                 r#"<rect x="{:.1}" y="{:.1}" width="12" height="10" fill="{}"/>"#,
-                right + 2.0 - 14.0 - 2.0,
+                right - 14.0,
                 yy - 9.0,
                 COLOURS[0]
             )
