@@ -8,7 +8,7 @@ Usage: quality_checks.py --slivermesh EXE [--tetgen EXE] [--model FILE.poly]
     figure of `quality --stats-json` equals this script's own (face-normal cosines + acos for
     the angles, not the library's sine form; nearest-rank percentiles);
   * the same mesh with 5 tets inverted and 1 of zero volume, as .node/.ele, and rewritten here as
-    medit .mesh, gmsh .msh 4.1 and VTK .vtu (another writer than ours): the readers accept it
+    medit .mesh, gmsh .msh 4.1 and 2.2 and VTK .vtu (another writer than ours): the readers accept it
     and every format gives the same figures, inverted 5 and zero-volume 1;
   * the SVG parses as XML and holds the bars (one per non-empty 1-degree bin) and the four
     threshold lines; --compare shows both meshes; the text has two-decimal angles;
@@ -172,6 +172,17 @@ def write_msh41(path, xyz, tets):
         f.write("$EndElements\n")
 
 
+def write_msh22(path, xyz, tets):
+    with open(path, "w") as f:
+        f.write("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n%d\n" % len(xyz))
+        for i, p in enumerate(xyz):
+            f.write("%d %r %r %r\n" % (i + 1, *p))
+        f.write("$EndNodes\n$Elements\n%d\n" % len(tets))
+        for i, t in enumerate(tets):
+            f.write("%d 4 2 7 1 %d %d %d %d\n" % (i + 1, *(v + 1 for v in t)))
+        f.write("$EndElements\n")
+
+
 def write_vtu(path, xyz, tets):
     with open(path, "w") as f:
         f.write('<?xml version="1.0"?>\n<VTKFile type="UnstructuredGrid" version="0.1" '
@@ -282,11 +293,13 @@ def main():
             check("independent: 5 inverted, 1 zero volume",
                   (want_bad["n_inverted"], want_bad["n_zero_volume"]) == (5, 1), str(want_bad))
             paths = [os.path.join(tmp, "bad.ele"), os.path.join(tmp, "bad.mesh"),
-                     os.path.join(tmp, "bad.msh"), os.path.join(tmp, "bad.vtu")]
+                     os.path.join(tmp, "bad.msh"), os.path.join(tmp, "bad.vtu"),
+                     os.path.join(tmp, "bad22.msh")]
             write_node_ele(paths[0][:-4], xyz, bad)
             write_medit(paths[1], xyz, bad)
             write_msh41(paths[2], xyz, bad)
             write_vtu(paths[3], xyz, bad)
+            write_msh22(paths[4], xyz, bad)
             for p in paths:
                 got, out = quality_json(exe, p, tmp)
                 if got:

@@ -16,14 +16,15 @@
 //!   surfaces. Element tags: tet i is i+1, boundary triangle j is #tets + j + 1, so the order
 //!   survives the grouping into blocks.
 //!
-//! Read: ASCII 4.1 and 2.x (`$MeshFormat` 4.1 or 2.0-2.2, file type 0). 4.1: `$Entities` supplies the first
-//! physical tag of each surface and volume (0 when it has none or `$Entities` is absent);
-//! `$Nodes` blocks (parametric coordinates skipped); `$Elements`: tets (4) and triangles (2) are
-//! kept, sorted by element tag, other known element types are read past; nodes are ordered by
-//! tag. 2.x (still written by many tools): `$Nodes` as `<id> <x> <y> <z>`, `$Elements` as
-//! `<id> <type> <#tags> <physical> ...`; the first tag (the physical group) is the region or
-//! marker, 0 without tags. `$PhysicalNames` and any other section are skipped. Not supported:
-//! binary files, MSH 4.0, high-order tets (their elements are read past).
+//! Read: ASCII 4.1 and 2.x (`$MeshFormat` 4.1 or 2.0-2.2, file type 0). 4.1: `$Entities`
+//! supplies the first physical tag of each surface and volume (0 when it has none or
+//! `$Entities` is absent); `$Nodes` blocks (parametric coordinates skipped); `$Elements`: tets
+//! (4) and triangles (2) are kept, sorted by element tag, other known element types are read
+//! past; nodes are ordered by tag. 2.x (still written by many tools): `$Nodes` as
+//! `<id> <x> <y> <z>`, `$Elements` as `<id> <type> <#tags> <physical> ...`; the first tag (the
+//! physical group) is the region or marker, 0 without tags. `$PhysicalNames` and any other
+//! section are skipped. Not supported: binary files, MSH 4.0, high-order tets (their elements
+//! are read past).
 
 use super::text::{
     check_mesh, check_mesh_io, create, err_at, read_text, with_path, write_err, Tokens, F,
