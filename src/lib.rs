@@ -12,6 +12,7 @@ pub mod geom;
 pub mod io;
 pub mod mesh;
 pub mod plc;
+pub mod quality;
 pub mod refine;
 pub mod surface;
 

@@ -1,7 +1,8 @@
 //! The `slivermesh` command line.
 //!
 //! `slivermesh` with no arguments runs the built-in demo (`cli::mesh::run_demo`);
-//! `slivermesh mesh` meshes a domain file; `slivermesh delaunay`
+//! `slivermesh mesh` meshes a domain file; `slivermesh quality` measures any tet mesh;
+//! `slivermesh delaunay`
 //! triangulates a point file; `slivermesh gen-points` writes the seeded point sets the
 //! benchmarks and the CGAL comparison (ctests/) share.
 
@@ -54,7 +55,13 @@ enum Command {
         /// Write the report as JSON to this file.
         #[arg(long, value_name = "FILE")]
         stats_json: Option<PathBuf>,
+        /// Write a histogram picture (SVG) of the output mesh's dihedral angles to this file.
+        #[arg(long, value_name = "FILE")]
+        quality_svg: Option<PathBuf>,
     },
+    /// Quality of any tet mesh (.mesh, .vtu, .msh, .node/.ele), ours or another tool's: the
+    /// table, a histogram of the per-tet minimum dihedral angle, --svg, --compare.
+    Quality(cli::quality::QualityArgs),
     /// Write a seeded point set (the inputs of the benchmarks and the CGAL comparison).
     GenPoints {
         /// uniform (unit cube), grid (integer k^3 grid, k = round(cbrt(n))), sphere (unit
@@ -89,7 +96,15 @@ fn main() -> ExitCode {
             output,
             options,
             stats_json,
-        }) => cli::mesh::run_mesh(&input, output.as_deref(), stats_json.as_deref(), &options),
+            quality_svg,
+        }) => cli::mesh::run_mesh(
+            &input,
+            output.as_deref(),
+            stats_json.as_deref(),
+            quality_svg.as_deref(),
+            &options,
+        ),
+        Some(Command::Quality(args)) => cli::quality::run(&args),
         Some(Command::Delaunay {
             points,
             output,

@@ -79,6 +79,7 @@ pub fn run_mesh(
     input: &Path,
     output: Option<&Path>,
     stats_json: Option<&Path>,
+    quality_svg: Option<&Path>,
     opts: &MeshOptions,
 ) -> Result<(), String> {
     let params = opts.params();
@@ -102,7 +103,7 @@ pub fn run_mesh(
         .map_err(|e| e.to_string())?;
         mesh_with_progress(&plc, &params, spacing)?
     };
-    finish(&mesh, &report, output, stats_json)
+    finish(&mesh, &report, output, stats_json, quality_svg)
 }
 
 fn mesh_with_progress(
@@ -139,6 +140,7 @@ fn finish(
     report: &Report,
     output: Option<&Path>,
     stats_json: Option<&Path>,
+    quality_svg: Option<&Path>,
 ) -> Result<(), String> {
     println!("{}", report.table());
     if let Some(path) = stats_json {
@@ -149,7 +151,9 @@ fn finish(
         write_with_quality(path, mesh)?;
         println!("wrote {}", path.display());
     }
-    Ok(())
+    // Measured on the mesh as written, the table `slivermesh quality` prints for that file.
+    let name = output.map_or("the output mesh".to_string(), |p| p.display().to_string());
+    super::quality::report_output(mesh, &name, quality_svg)
 }
 
 /// Writes the mesh, with per-tet quality as cell data (radius-edge ratio, sigma, min dihedral)
@@ -245,5 +249,11 @@ pub fn run_demo() -> Result<(), String> {
     let f = FnSpacing(|p: DVec3| 0.02 + 0.1 * p.length());
     let params = Params::default();
     let (mesh, report) = mesh_with_progress(&plc, &params, Some(&f))?;
-    finish(&mesh, &report, Some(Path::new("slivermesh-demo.vtu")), None)
+    finish(
+        &mesh,
+        &report,
+        Some(Path::new("slivermesh-demo.vtu")),
+        None,
+        None,
+    )
 }

@@ -2,5 +2,6 @@
 
 pub mod gen;
 pub mod mesh;
+pub mod quality;
 pub mod rss;
 pub mod tri;

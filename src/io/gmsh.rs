@@ -16,12 +16,15 @@
 //!   surfaces. Element tags: tet i is i+1, boundary triangle j is #tets + j + 1, so the order
 //!   survives the grouping into blocks.
 //!
-//! Read: ASCII 4.1 only (`$MeshFormat` 4.1, file type 0). `$Entities` supplies the first
-//! physical tag of each surface and volume (0 when it has none or `$Entities` is absent);
-//! `$Nodes` blocks (parametric coordinates skipped); `$Elements`: tets (4) and triangles (2) are
-//! kept, sorted by element tag, other known element types are read past; nodes are ordered by
-//! tag. `$PhysicalNames` and any other section are skipped. Not supported: binary files,
-//! MSH 2.x and 4.0, high-order tets (their blocks are read past).
+//! Read: ASCII 4.1 and 2.x (`$MeshFormat` 4.1 or 2.0-2.2, file type 0). 4.1: `$Entities`
+//! supplies the first physical tag of each surface and volume (0 when it has none or
+//! `$Entities` is absent); `$Nodes` blocks (parametric coordinates skipped); `$Elements`: tets
+//! (4) and triangles (2) are kept, sorted by element tag, other known element types are read
+//! past; nodes are ordered by tag. 2.x (still written by many tools): `$Nodes` as
+//! `<id> <x> <y> <z>`, `$Elements` as `<id> <type> <#tags> <physical> ...`; the first tag (the
+//! physical group) is the region or marker, 0 without tags. `$PhysicalNames` and any other
+//! section are skipped. Not supported: binary files, MSH 4.0, high-order tets (their elements
+//! are read past).
 
 use super::text::{
     check_mesh, check_mesh_io, create, err_at, read_text, with_path, write_err, Tokens, F,
@@ -272,7 +275,7 @@ fn parse_entities(tok: &mut Tokens) -> Result<(Physicals, Physicals), IoError> {
 /// Parses the text of a gmsh 4.1 ASCII `.msh` file.
 pub fn parse_msh(text: &str) -> Result<TetMesh, IoError> {
     let mut tok = Tokens::new(text);
-    let mut seen_format = false;
+    let (mut seen_format, mut v2) = (false, false);
     let (mut surf, mut vol) = (Physicals::default(), Physicals::default());
     let mut nodes: Vec<(i64, usize, DVec3)> = Vec::new();
     // (element tag, line, node tags, (entity dimension, entity tag))
@@ -291,10 +294,11 @@ pub fn parse_msh(text: &str) -> Result<TetMesh, IoError> {
         match name {
             "MeshFormat" => {
                 let (l, v) = tok.next("version")?;
-                if v != "4.1" {
+                v2 = matches!(v, "2" | "2.0" | "2.1" | "2.2");
+                if v != "4.1" && !v2 {
                     return Err(err_at(
                         l,
-                        format!("unsupported MSH version '{v}': only 4.1 is supported"),
+                        format!("unsupported MSH version '{v}': only 4.1 and 2.x are supported"),
                     ));
                 }
                 let (l, ft) = tok.next("file type")?;
@@ -307,6 +311,17 @@ pub fn parse_msh(text: &str) -> Result<TetMesh, IoError> {
             }
             "Entities" => {
                 (surf, vol) = parse_entities(&mut tok)?;
+                expect_end(&mut tok, name)?;
+            }
+            "Nodes" if v2 => {
+                for _ in 0..tok.usize("number of nodes")? {
+                    let (l, t) = tok.raw_index("node tag")?;
+                    nodes.push((t, l, tok.point()?));
+                }
+                expect_end(&mut tok, name)?;
+            }
+            "Elements" if v2 => {
+                parse_v2_elements(&mut tok, &mut tets, &mut tris, &mut surf, &mut vol)?;
                 expect_end(&mut tok, name)?;
             }
             "Nodes" => {
@@ -430,6 +445,48 @@ pub fn parse_msh(text: &str) -> Result<TetMesh, IoError> {
     Ok(mesh)
 }
 
+/// MSH 2.x `$Elements`: the first tag (physical group) becomes the element's entity, mapped
+/// to itself, so regions and markers come out as with 4.1's entities.
+fn parse_v2_elements(
+    tok: &mut Tokens,
+    tets: &mut Vec<ElementRecord<4>>,
+    tris: &mut Vec<ElementRecord<3>>,
+    surf: &mut Physicals,
+    vol: &mut Physicals,
+) -> Result<(), IoError> {
+    for _ in 0..tok.usize("number of elements")? {
+        let (l, tag) = tok.raw_index("element tag")?;
+        let (lt, w) = tok.next("element type")?;
+        let ty = super::text::parse_i64(w, lt, "element type")?;
+        let k = nodes_per_element(ty)
+            .ok_or_else(|| err_at(lt, format!("unknown element type {ty}")))?;
+        let mut physical = 0;
+        for i in 0..tok.usize("number of tags")? {
+            let t = tok.i32("element tag value")?;
+            if i == 0 {
+                physical = t;
+            }
+        }
+        let mut ids = [0i64; 20];
+        for id in ids.iter_mut().take(k) {
+            *id = tok.raw_index("element node tag")?.1;
+        }
+        let p = i64::from(physical);
+        match ty {
+            4 => {
+                vol.insert(p, physical);
+                tets.push((tag, l, [ids[0], ids[1], ids[2], ids[3]], (3, p)));
+            }
+            2 => {
+                surf.insert(p, physical);
+                tris.push((tag, l, [ids[0], ids[1], ids[2]], (2, p)));
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
 /// (element tag, line, node tags, (entity dimension, entity tag)) of one parsed element.
 type ElementRecord<const N: usize> = (i64, usize, [i64; N], (usize, i64));
 
@@ -484,7 +541,11 @@ mod tests {
         let good = text(&two_tets());
         let line = |pat: &str| good[..good.find(pat).unwrap()].matches('\n').count() + 1;
         expect_err("", 1, "not a .msh");
-        expect_err("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n", 2, "only 4.1");
+        expect_err(
+            "$MeshFormat\n3.0 0 8\n$EndMeshFormat\n",
+            2,
+            "only 4.1 and 2.x",
+        );
         expect_err("$MeshFormat\n4.1 1 8\n$EndMeshFormat\n", 2, "binary");
         expect_err("$Nodes\n", 1, "'$MeshFormat' first");
         expect_err("$MeshFormat\n4.1 0 8\n", 3, "unexpected end");
@@ -518,6 +579,29 @@ mod tests {
             line("\n0 1 0\n") + 1,
             "bad number 'one'",
         );
+    }
+
+    /// `two_tets` as gmsh 2.2 writes it (one physical tag and one elementary tag per element,
+    /// a point element, node ids not in order, the second tet inverted on purpose).
+    const TWO_TETS_V22: &str = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n\
+        $PhysicalNames\n1\n3 5 \"v\"\n$EndPhysicalNames\n$Nodes\n5\n\
+        2 1 0 0\n1 0 0 0\n3 0 1 0\n4 0 0 1\n5 1 1 1\n$EndNodes\n\
+        $Elements\n6\n1 15 2 0 1 1\n2 2 2 3 1 1 3 2\n3 2 2 0 1 2 3 5\n4 2 2 3 1 1 2 4\n\
+        5 4 0 1 2 3 4\n6 4 2 5 2 3 2 4 5\n$EndElements\n";
+
+    #[test]
+    fn reads_msh_2_2() {
+        let m = parse_msh(TWO_TETS_V22).unwrap();
+        let mut want = two_tets();
+        want.tets[1] = [2, 1, 3, 4];
+        assert_eq!(m, want);
+        let e =
+            parse_msh(&TWO_TETS_V22.replace("6 4 2 5 2 3 2 4 5", "6 4 2 5 2 3 2 4 9")).unwrap_err();
+        assert_eq!(e.line, Some(23), "{e}");
+        assert!(e.message.contains("unknown node tag 9"), "{e}");
+        for cut in 0..TWO_TETS_V22.len() {
+            let _ = parse_msh(&TWO_TETS_V22[..cut]);
+        }
     }
 
     #[test]

@@ -11,7 +11,7 @@
 //! | Wavefront `.obj` | domain | | [`obj`] |
 //! | medit `.mesh` | mesh ([`TetMesh`]) | mesh | [`medit`] |
 //! | VTK `.vtu` | mesh + cell fields | mesh + cell fields | [`vtu`] |
-//! | gmsh `.msh` 4.1 | mesh | mesh | [`gmsh`] |
+//! | gmsh `.msh` 4.1 (read: also 2.x) | mesh | mesh | [`gmsh`] |
 //! | TetGen `.node`/`.ele`/`.face` | mesh | mesh | [`tetgen`] |
 //!
 //! [`read_plc`], [`read_mesh`] and [`write_mesh`] choose the format by extension
