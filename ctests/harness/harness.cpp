@@ -180,7 +180,7 @@ struct Side {
   std::string tets_vtu, faces_vtu;
 };
 
-void print_table(const Side& ours, const Side* cgal) {
+void print_table(const Side& ours, const Side* cgal, int repeat) {
   auto row = [&](const char* label, const std::function<std::string(const Side&)>& f) {
     std::printf("  %-24s %16s %16s\n", label, f(ours).c_str(), cgal ? f(*cgal).c_str() : "-");
   };
@@ -194,7 +194,8 @@ void print_table(const Side& ours, const Side* cgal) {
   row("vertices", [](const Side& s) { return std::to_string(s.chosen.run.mesh.points.size()); });
   row("tets", [](const Side& s) { return std::to_string(s.q.total.n_tets); });
   row("boundary triangles", [](const Side& s) { return std::to_string(s.chosen.run.mesh.faces.size()); });
-  row("seconds (meshing)", [&](const Side& s) { return fmt("%.3f", s.chosen.run.seconds); });
+  const std::string secs = repeat > 1 ? "seconds (best of " + std::to_string(repeat) + ")" : "seconds (meshing)";
+  row(secs.c_str(), [&](const Side& s) { return fmt("%.3f", s.chosen.run.seconds); });
   row("tets/s", [&](const Side& s) { return fmt("%.0f", s.q.total.n_tets / s.chosen.run.seconds); });
   row("min dihedral (deg)", [&](const Side& s) { return fmt("%.2f", s.q.total.min_dihedral_deg); });
   row("max dihedral (deg)", [&](const Side& s) { return fmt("%.2f", s.q.total.max_dihedral_deg); });
@@ -238,11 +239,15 @@ int run(const Options& o) {
   }
   for (int k = 1; k < o.repeat; ++k) {  // timing reruns at the chosen sizes, fastest kept
     RunResult r = mesh_slivermesh(d, ours.chosen.size, o.params);
+    std::printf("  rerun %d: slivermesh %.3f s", k, r.seconds);
     if (r.seconds < ours.chosen.run.seconds) ours.chosen.run = std::move(r);
     if (cgal) {
       RunResult c = mesh_cgal(d, cgal->chosen.size);
+      std::printf(", CGAL Mesh_3 %.3f s", c.seconds);
       if (c.seconds < cgal->chosen.run.seconds) cgal->chosen.run = std::move(c);
     }
+    std::printf("\n");
+    std::fflush(stdout);
   }
 
   for (Side* s : {&ours, cgal ? &*cgal : nullptr}) {
@@ -260,7 +265,7 @@ int run(const Options& o) {
 
   std::printf("\nharness table: %s, slivermesh (%s) vs CGAL Mesh_3 (%s)", o.input.c_str(),
               ours.chosen.run.note.c_str(), cgal ? cgal->chosen.run.note.c_str() : "not run");
-  print_table(ours, cgal ? &*cgal : nullptr);
+  print_table(ours, cgal ? &*cgal : nullptr, o.repeat);
   std::printf("VTK files: %s, %s", ours.tets_vtu.c_str(), ours.faces_vtu.c_str());
   if (cgal) std::printf(", %s, %s", cgal->tets_vtu.c_str(), cgal->faces_vtu.c_str());
   std::printf("\n");
