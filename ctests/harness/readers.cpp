@@ -289,7 +289,10 @@ Domain read_poly(const std::string& path) {
     }
     if (n > 1) d.cgal_unsupported = "several regions";
   }
-  if (!r.done()) r.next("nothing"), r.fail("unexpected data after the regions");
+  if (!r.done()) {
+    r.next("nothing");
+    r.fail("unexpected data after the regions");
+  }
   if (!d.cgal_unsupported.empty()) d.surface.clear();
   return d;
 }
