@@ -257,6 +257,9 @@ def main():
     ap.add_argument("--slivermesh", required=True)
     ap.add_argument("--tetgen")
     ap.add_argument("--model", help="a .poly for tetgen and `slivermesh mesh`")
+    ap.add_argument("--fudge", type=float, default=0.0,
+                    help="add this many degrees to the independent minimum dihedral angle (a "
+                         "ctest checks that 1e-4 is caught)")
     args = ap.parse_args()
     exe = args.slivermesh
     if not os.access(exe, os.X_OK):
@@ -275,6 +278,7 @@ def main():
             stem = os.path.join(d, "in.1")
             xyz, tets = read_node_ele(stem)
             want = figures(xyz, tets)
+            want["min_dihedral_deg"] += args.fudge
             got, out = quality_json(exe, stem + ".ele", tmp)
             if got:
                 compare_figures("tetgen mesh", got, want)

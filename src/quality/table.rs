@@ -12,6 +12,16 @@ fn fixed(x: f64, prec: usize) -> String {
     }
 }
 
+/// A shape measure with four decimals, in exponent form when that would hide it (a near-flat
+/// tet's sigma of 1e-12, its aspect of 1e14).
+fn shape(x: f64) -> String {
+    if x.is_finite() && x != 0.0 && !(1e-3..1e6).contains(&x.abs()) {
+        format!("{x:.4e}")
+    } else {
+        fixed(x, 4)
+    }
+}
+
 /// A length or volume with six significant digits, whatever the mesh's scale.
 fn sig(x: f64) -> String {
     if x == 0.0 || (1e-2..1e6).contains(&x.abs()) {
@@ -83,15 +93,15 @@ pub fn rows(q: &MeshQuality) -> Vec<(String, String)> {
     );
     row(
         "rho R/L max / median",
-        format!("{} / {}", fixed(q.max_rho, 4), fixed(q.median_rho, 4)),
+        format!("{} / {}", shape(q.max_rho), shape(q.median_rho)),
     );
     row(
         "sigma V/L^3 min / median",
-        format!("{} / {}", fixed(q.min_sigma, 4), fixed(q.median_sigma, 4)),
+        format!("{} / {}", shape(q.min_sigma), shape(q.median_sigma)),
     );
     row(
         "aspect R/(3r) max / median",
-        format!("{} / {}", fixed(q.max_aspect, 4), fixed(q.median_aspect, 4)),
+        format!("{} / {}", shape(q.max_aspect), shape(q.median_aspect)),
     );
     row("worst tet (0-based)", q.worst_tet.to_string());
     r

@@ -371,6 +371,18 @@ fn bad_meshes_are_errors_not_panics() {
 }
 
 #[test]
+fn near_flat_shape_measures_are_not_printed_as_zero() {
+    let mut near = flat();
+    near[3] = DVec3::new(0.3, 0.3, 1e-9);
+    let t = table(&measure(&mesh_of(&[near])).unwrap());
+    let row = |k: &str| t.lines().find(|l| l.contains(k)).unwrap().to_string();
+    assert!(row("sigma").contains("e-"), "{t}");
+    assert!(row("aspect").contains('e'), "{t}");
+    assert!(row("dihedral min / max").contains("0.00 / 180.00"), "{t}");
+    assert!(row("inverted / zero-volume").ends_with("0 / 0"), "{t}");
+}
+
+#[test]
 fn table_and_histogram_text() {
     let m = mesh_of(&[regular(), sliver(), cap(), needle(), inverted()]);
     let q = measure(&m).unwrap();
