@@ -5,7 +5,10 @@
 //! → `refine` (Li's REMOVE-SLIVER) → `delaunay` (3D kernel) → `geom` (exact predicates, measures).
 //! `mesh` holds the output model shared by writers and meshers. See ARCHITECTURE.md.
 
+#![deny(clippy::undocumented_unsafe_blocks)]
+
 pub mod api;
+pub mod cdt;
 pub mod delaunay;
 pub mod ffi;
 pub mod geom;
@@ -13,6 +16,7 @@ pub mod io;
 pub mod mesh;
 pub mod plc;
 pub mod refine;
+mod union_find;
 
 pub use glam::DVec3;
 pub use mesh::TetMesh;
