@@ -5,7 +5,10 @@
 //! → `refine` (Li's REMOVE-SLIVER) → `delaunay` (3D kernel) → `geom` (exact predicates, measures).
 //! `mesh` holds the output model shared by writers and meshers. See ARCHITECTURE.md.
 
+#![deny(clippy::undocumented_unsafe_blocks)]
+
 pub mod api;
+pub mod cdt;
 pub mod delaunay;
 pub mod ffi;
 pub mod geom;
@@ -15,6 +18,7 @@ pub mod plc;
 pub mod quality;
 pub mod refine;
 pub mod surface;
+mod union_find;
 
 pub use glam::DVec3;
 pub use mesh::TetMesh;

@@ -6,6 +6,8 @@
 //! triangulates a point file; `slivermesh gen-points` writes the seeded point sets the
 //! benchmarks and the CGAL comparison (ctests/) share.
 
+#![deny(clippy::undocumented_unsafe_blocks)]
+
 mod cli;
 
 use clap::{Parser, Subcommand};

@@ -44,9 +44,26 @@ fn refined(
     let input = read_model(rel);
     let (m, report) = mesh(&input, params, spacing, None).unwrap_or_else(|e| panic!("{rel}: {e}"));
     assert!(report.complete, "{rel}: {:?}", report.stop_reason);
+    assert_eq!(report.n_relabelled, 0, "{rel}: region labels leaked");
     check_conforming(rel, &input, &m, volume);
     check_quality(rel, &m, params);
     m
+}
+
+/// Why refinement re-marks the regions after a pass (the pass loop of `refine::mesh`): next to
+/// small input angles the region labels tets inherit through cavities leak across the
+/// boundary while it is being split (measured at default settings: elephant 709 tets after the
+/// first pass, part 8,215, oblong 4,592), so they cannot be kept incrementally there; the
+/// re-marking from the seeds corrects them and the next pass refines the relabelled tets. On
+/// acute-free models nothing leaks (`refined` checks that).
+#[test]
+fn region_labels_leak_next_to_small_angles_and_the_remarking_repairs_them() {
+    let rel = "off/elephant.off";
+    let input = read_model(rel);
+    let (m, report) =
+        mesh(&input, &Params::default(), None, None).unwrap_or_else(|e| panic!("{rel}: {e}"));
+    assert!(report.n_relabelled > 0, "{rel}: no label leaked");
+    check_conforming(rel, &input, &m, None);
 }
 
 #[test]

@@ -284,14 +284,18 @@ impl Delaunay {
                 }
                 let fan = InsphereFan::new(q, p);
                 for (&a, &i) in apex.iter().zip(&faces) {
-                    self.test_face(&mut s, &fan, t, v, i, nb[i], a, p, rank);
+                    // SAFETY: 4 slots of each were reserved for this tet; 3 calls push at
+                    // most one each.
+                    unsafe { self.test_face(&mut s, &fan, t, v, i, nb[i], a, p, rank) };
                 }
             } else {
                 // The start tet: all four faces.
                 let fan = InsphereFan::new(q, p);
                 for (i, &r) in nb.iter().enumerate() {
                     let a = self.tet_ref(r >> 2).v[(r & 3) as usize];
-                    self.test_face(&mut s, &fan, t, v, i, r, a, p, rank);
+                    // SAFETY: 4 slots of each were reserved for this tet; 4 calls push at
+                    // most one each.
+                    unsafe { self.test_face(&mut s, &fan, t, v, i, r, a, p, rank) };
                 }
             }
         }
@@ -308,9 +312,13 @@ impl Delaunay {
     /// One neighbour of a dequeued finite cavity tet `t` (vertices `v`): the neighbour across
     /// face `i` (reference `r`, apex `apex`) is tested if unmarked, and joins the cavity or
     /// makes face `i` a boundary face.
+    ///
+    /// # Safety
+    /// `s.cavity`, `s.entry` and `s.boundary` must each have spare capacity for one more
+    /// element (the pushes are unchecked).
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn test_face(
+    unsafe fn test_face(
         &mut self,
         s: &mut Scratch,
         fan: &InsphereFan,
@@ -341,7 +349,8 @@ impl Delaunay {
             (false, m == OUTSIDE)
         };
         // Branch-free pushes: write the slot, advance the length by the condition.
-        // SAFETY: the caller reserved capacity for 4 more of each.
+        // SAFETY: the caller guarantees capacity for one more of each (the fn's contract); each
+        // vector gets at most one element here.
         unsafe {
             let len = s.cavity.len();
             s.cavity.as_mut_ptr().add(len).write(n);
@@ -363,6 +372,8 @@ impl Delaunay {
     #[inline(always)]
     fn prefetch_point(&self, v: u32) {
         #[cfg(target_arch = "x86_64")]
+        // SAFETY: a prefetch never faults and reads nothing (any address is allowed); the
+        // pointer arithmetic wraps, so it is defined for any id. SSE is baseline on x86_64.
         unsafe {
             use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
             // wrapping: the address is only a hint, never dereferenced
@@ -376,12 +387,14 @@ impl Delaunay {
     #[inline(always)]
     fn prefetch_neighbors(&self, t: u32) {
         #[cfg(target_arch = "x86_64")]
+        // SAFETY: a prefetch never faults and reads nothing; the pointer arithmetic wraps, so
+        // it is defined for any neighbour reference. SSE is baseline on x86_64.
         unsafe {
             use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
             for r in self.tet_ref(t).n {
                 let n = (r >> 2) as usize;
-                _mm_prefetch(self.tets.as_ptr().add(n) as *const i8, _MM_HINT_T0);
-                _mm_prefetch(self.mark.as_ptr().add(n) as *const i8, _MM_HINT_T0);
+                _mm_prefetch(self.tets.as_ptr().wrapping_add(n) as *const i8, _MM_HINT_T0);
+                _mm_prefetch(self.mark.as_ptr().wrapping_add(n) as *const i8, _MM_HINT_T0);
             }
         }
     }

@@ -99,10 +99,18 @@ const EDGE_FACES: [[usize; 2]; 6] = [[2, 3], [1, 3], [1, 2], [0, 3], [0, 2], [0,
 /// squared lengths and det = det[u, v, w] from the adaptive orientation predicate.
 #[inline(always)]
 fn circum_offset(u: DVec3, v: DVec3, w: DVec3, l2: [f64; 3], det: f64) -> Option<DVec3> {
+    circum_offset_crossed([v.cross(w), w.cross(u), u.cross(v)], l2, det)
+}
+
+/// The one circumcentre formula (see [`circumcenter`]): the offset from a, given the cross
+/// products `[v×w, w×u, u×v]` of u = b-a, v = c-a, w = d-a, their squared lengths `l2` and
+/// det = det[u, v, w] (from [`orient3d`]). For callers that have the cross products already.
+#[inline(always)]
+pub fn circum_offset_crossed(cross: [DVec3; 3], l2: [f64; 3], det: f64) -> Option<DVec3> {
     if det == 0.0 {
         return None;
     }
-    let num = l2[0] * v.cross(w) + l2[1] * w.cross(u) + l2[2] * u.cross(v);
+    let num = l2[0] * cross[0] + l2[1] * cross[1] + l2[2] * cross[2];
     let o = num * (0.5 / det);
     if o.is_finite() {
         Some(o)
@@ -361,10 +369,9 @@ impl TetQuality {
             return TetQuality::flat(shortest_edge);
         }
         let (vw, wu, uv) = (v.cross(w), w.cross(u), u.cross(v));
-        let off = (l2[0] * vw + l2[1] * wu + l2[2] * uv) * (0.5 / det);
-        if !off.is_finite() {
+        let Some(off) = circum_offset_crossed([vw, wu, uv], [l2[0], l2[1], l2[2]], det) else {
             return TetQuality::flat(shortest_edge);
-        }
+        };
         let circumradius = off.length();
         // Same as face_normals(u, v, w), reusing the cross products.
         let n = [(v - u).cross(w - u), -vw, -wu, -uv];

@@ -3,6 +3,7 @@
 
 pub mod measures;
 pub mod predicates;
+pub mod screen;
 
 pub use measures::*;
 pub use predicates::*;

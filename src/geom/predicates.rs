@@ -70,6 +70,7 @@ pub const MIN_COORD: f64 = 1e-30;
 #[inline(always)]
 fn fmax(a: f64, b: f64) -> f64 {
     #[cfg(target_arch = "x86_64")]
+    // SAFETY: SSE2 is baseline on x86_64; the intrinsics only move and compare registers.
     unsafe {
         use std::arch::x86_64::{_mm_cvtsd_f64, _mm_max_sd, _mm_set_sd};
         _mm_cvtsd_f64(_mm_max_sd(_mm_set_sd(a), _mm_set_sd(b)))
@@ -82,6 +83,7 @@ fn fmax(a: f64, b: f64) -> f64 {
 #[inline(always)]
 fn fmin(a: f64, b: f64) -> f64 {
     #[cfg(target_arch = "x86_64")]
+    // SAFETY: SSE2 is baseline on x86_64; the intrinsics only move and compare registers.
     unsafe {
         use std::arch::x86_64::{_mm_cvtsd_f64, _mm_min_sd, _mm_set_sd};
         _mm_cvtsd_f64(_mm_min_sd(_mm_set_sd(a), _mm_set_sd(b)))

@@ -14,6 +14,7 @@ use super::error::{PlcError, Seed};
 use super::exact::{orient3, point_in_triangle_3d};
 use super::topology::{sorted, FanEntry, Topology};
 use super::Region;
+use crate::union_find::UnionFind;
 use glam::DVec3;
 use rustc_hash::FxHashSet;
 use std::cmp::Ordering;
@@ -43,25 +44,6 @@ pub(crate) struct CellMap {
     pub triangle_cells: Vec<[u32; 2]>,
 }
 
-struct UnionFind(Vec<u32>);
-
-impl UnionFind {
-    fn find(&mut self, mut x: u32) -> u32 {
-        while self.0[x as usize] != x {
-            let p = self.0[x as usize];
-            self.0[x as usize] = self.0[p as usize];
-            x = p;
-        }
-        x
-    }
-    fn union(&mut self, a: u32, b: u32) {
-        let (ra, rb) = (self.find(a), self.find(b));
-        if ra != rb {
-            self.0[ra.max(rb) as usize] = ra.min(rb);
-        }
-    }
-}
-
 /// Side ids: 2t is the normal (+) side of global triangle t, 2t + 1 the other side.
 fn side(t: u32, plus: bool) -> u32 {
     2 * t + u32::from(!plus)
@@ -75,7 +57,7 @@ pub(crate) fn build_cells(
     regions: &[Region],
 ) -> Result<CellMap, PlcError> {
     let ntri = topo.tris.len() as u32;
-    let mut uf = UnionFind((0..2 * ntri).collect());
+    let mut uf = UnionFind::new(2 * ntri as usize);
     let mut fans: Vec<Vec<(u32, u32)>> = vec![Vec::new(); topo.segments.len()]; // (tri, ccw side)
     for (edge, users) in &topo.edge_tris {
         let Some(&s) = topo.segment_of.get(edge) else {

@@ -21,6 +21,7 @@
 
 use crate::geom::orient3d;
 use crate::plc::{Facet, PlcInput};
+use crate::union_find::UnionFind;
 use glam::DVec3;
 use rustc_hash::FxHashMap;
 
@@ -54,7 +55,7 @@ pub fn merge_coplanar_facets(plc: &mut PlcInput) {
             continue;
         }
         let ((f, df), (g, dg)) = (uses[0], uses[1]);
-        if f == g || df == dg || uf.find(f) == uf.find(g) {
+        if f == g || df == dg || uf.find(f as u32) == uf.find(g as u32) {
             continue;
         }
         let (pf, pg) = match (&planes[f], &planes[g]) {
@@ -68,7 +69,7 @@ pub fn merge_coplanar_facets(plc: &mut PlcInput) {
             .iter()
             .all(|&v| pf.contains(verts[v as usize]));
         if coplanar {
-            uf.union(f, g);
+            uf.union(f as u32, g as u32);
         }
     }
 
@@ -76,7 +77,7 @@ pub fn merge_coplanar_facets(plc: &mut PlcInput) {
     let mut group_of_root: FxHashMap<usize, usize> = FxHashMap::default();
     let mut groups: Vec<Vec<usize>> = Vec::new();
     for fi in 0..facets.len() {
-        let r = uf.find(fi);
+        let r = uf.find(fi as u32) as usize;
         let gi = *group_of_root.entry(r).or_insert_with(|| {
             groups.push(Vec::new());
             groups.len() - 1
@@ -243,35 +244,6 @@ fn merge_group(group: &[usize], facets: &[Facet], verts: &[DVec3], normal: DVec3
         hole_polygons: holes,
         marker: 0,
     })
-}
-
-struct UnionFind {
-    parent: Vec<usize>,
-}
-
-impl UnionFind {
-    fn new(n: usize) -> Self {
-        UnionFind {
-            parent: (0..n).collect(),
-        }
-    }
-
-    fn find(&mut self, mut x: usize) -> usize {
-        while self.parent[x] != x {
-            self.parent[x] = self.parent[self.parent[x]];
-            x = self.parent[x];
-        }
-        x
-    }
-
-    fn union(&mut self, a: usize, b: usize) {
-        let (ra, rb) = (self.find(a), self.find(b));
-        if ra != rb {
-            // Keep the smaller index as root so groups are keyed by their first facet.
-            let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
-            self.parent[hi] = lo;
-        }
-    }
 }
 
 #[cfg(test)]

@@ -2,8 +2,8 @@
 //! the subsegments and each facet's 2D triangulation (its subfacets), and what every vertex
 //! lies on.
 
-use super::facet_mesh::{Change, FacetMesh};
 use super::MeshError;
+use crate::cdt::{Change, FacetMesh};
 use crate::delaunay::{Delaunay, Inserted};
 use crate::plc::PlcInput;
 use glam::DVec3;

@@ -18,6 +18,7 @@ use super::{mesh_domain, ConstantSpacing, MeshError, Params, Report};
 use crate::geom::orient3d;
 use crate::mesh::TetMesh;
 use crate::plc::{Facet, PlcInput, Region};
+use crate::union_find::UnionFind;
 use glam::DVec3;
 use rustc_hash::{FxHashMap, FxHashSet};
 
@@ -173,7 +174,7 @@ fn region_seeds(
     face_tets: &FxHashMap<[u32; 3], FaceTets>,
     is_facet: &FxHashSet<[u32; 3]>,
 ) -> Vec<Region> {
-    let mut uf = UnionFind((0..m.tets.len() as u32).collect());
+    let mut uf = UnionFind::new(m.tets.len());
     for (key, ft) in face_tets {
         if let Some(s) = ft.second {
             if !is_facet.contains(key) {
@@ -249,7 +250,7 @@ fn merge_flat_patches(vertices: &[DVec3], mut triangles: Vec<([u32; 3], i32)>) -
                 .push(i as u32);
         }
     }
-    let mut uf = UnionFind((0..triangles.len() as u32).collect());
+    let mut uf = UnionFind::new(triangles.len());
     for users in edge_users.values() {
         if let &[f, g] = &users[..] {
             let ((tf, mf), (tg, mg)) = (triangles[f as usize], triangles[g as usize]);
@@ -331,26 +332,6 @@ fn merge_flat_patches(vertices: &[DVec3], mut triangles: Vec<([u32; 3], i32)>) -
         }));
     }
     facets
-}
-
-struct UnionFind(Vec<u32>);
-
-impl UnionFind {
-    fn find(&mut self, mut x: u32) -> u32 {
-        while self.0[x as usize] != x {
-            let p = self.0[x as usize];
-            self.0[x as usize] = self.0[p as usize];
-            x = p;
-        }
-        x
-    }
-
-    fn union(&mut self, a: u32, b: u32) {
-        let (ra, rb) = (self.find(a), self.find(b));
-        if ra != rb {
-            self.0[ra.max(rb) as usize] = ra.min(rb);
-        }
-    }
 }
 
 #[cfg(test)]

@@ -7,6 +7,7 @@ use super::domain::{tri_key, Domain, VertexKind};
 use super::MeshError;
 use crate::delaunay::{tables::FACE, INFINITE};
 use crate::plc::PlcInput;
+use crate::union_find::UnionFind;
 
 /// Region attribute and size limit of each component tag (index 0 = outside, unused).
 #[derive(Debug, Clone, Default)]
@@ -30,50 +31,9 @@ impl Domain {
         input: &PlcInput,
         unseeded: Unseeded,
     ) -> Result<Regions, MeshError> {
+        let (comp, mut outside) = self.components();
+        let n_comp = outside.len() as u32;
         let cap = self.dt.tet_capacity();
-        // Only a face whose three vertices lie on the boundary can be a subfacet: test that
-        // before the hash lookup (most faces have a volume vertex).
-        let on_boundary: Vec<bool> = self.kind.iter().map(|&k| k != VertexKind::Volume).collect();
-        let is_subfacet = |f: [u32; 3]| {
-            !f.contains(&INFINITE)
-                && f.iter().all(|&x| on_boundary[x as usize])
-                && self.subfacets.contains_key(&tri_key(f))
-        };
-        // Union-find over the faces that are not subfacets, scanning the tets in memory order
-        // (a flood fill would visit them in a cache-hostile order). Each face once: from the
-        // tet with the smaller id.
-        let mut parent: Vec<u32> = (0..cap as u32).collect();
-        for t in 0..cap as u32 {
-            if !self.dt.is_alive(t) {
-                continue;
-            }
-            let v = self.dt.tet(t);
-            for (i, n) in self.dt.neighbors(t).into_iter().enumerate() {
-                if n > t && !is_subfacet(FACE[i].map(|k| v[k])) {
-                    union(&mut parent, t, n);
-                }
-            }
-        }
-        // Components numbered in the order of their smallest tet id.
-        let mut comp = vec![u32::MAX; cap];
-        let mut outside = vec![];
-        let mut n_comp = 0u32;
-        for t in 0..cap as u32 {
-            if !self.dt.is_alive(t) {
-                continue;
-            }
-            let r = find(&mut parent, t) as usize;
-            if comp[r] == u32::MAX {
-                comp[r] = n_comp;
-                n_comp += 1;
-                outside.push(false);
-            }
-            let c = comp[r];
-            comp[t as usize] = c;
-            if !self.dt.is_finite(t) {
-                outside[c as usize] = true; // touches the hull
-            }
-        }
         let mut attribute: Vec<Option<i32>> = vec![None; n_comp as usize];
         let mut max_size: Vec<Option<f64>> = vec![None; n_comp as usize];
         for (k, h) in input.holes.iter().enumerate() {
@@ -129,26 +89,55 @@ impl Domain {
         }
         Ok(regions)
     }
-}
 
-/// Union-find root of `t`, halving the path on the way.
-#[inline]
-fn find(parent: &mut [u32], mut t: u32) -> u32 {
-    while parent[t as usize] != t {
-        let g = parent[parent[t as usize] as usize];
-        parent[t as usize] = g;
-        t = g;
-    }
-    t
-}
-
-#[inline]
-fn union(parent: &mut [u32], a: u32, b: u32) {
-    let (ra, rb) = (find(parent, a), find(parent, b));
-    // The smaller id becomes the root.
-    if ra < rb {
-        parent[rb as usize] = ra;
-    } else if rb < ra {
-        parent[ra as usize] = rb;
+    /// The components of the triangulation bounded by subfacets: the component of every tet
+    /// slot (numbered in the order of their smallest tet id; dead slots: whatever) and, per
+    /// component, whether it touches the hull.
+    fn components(&self) -> (Vec<u32>, Vec<bool>) {
+        let cap = self.dt.tet_capacity();
+        // Only a face whose three vertices lie on the boundary can be a subfacet: test that
+        // before the hash lookup (most faces have a volume vertex).
+        let on_boundary: Vec<bool> = self.kind.iter().map(|&k| k != VertexKind::Volume).collect();
+        let is_subfacet = |f: [u32; 3]| {
+            !f.contains(&INFINITE)
+                && f.iter().all(|&x| on_boundary[x as usize])
+                && self.subfacets.contains_key(&tri_key(f))
+        };
+        // Union-find over the faces that are not subfacets, scanning the tets in memory order
+        // (a flood fill would visit them in a cache-hostile order). Each face once: from the
+        // tet with the smaller id.
+        let mut uf = UnionFind::new(cap);
+        for t in 0..cap as u32 {
+            if !self.dt.is_alive(t) {
+                continue;
+            }
+            let v = self.dt.tet(t);
+            for (i, n) in self.dt.neighbors(t).into_iter().enumerate() {
+                if n > t && !is_subfacet(FACE[i].map(|k| v[k])) {
+                    uf.union(t, n);
+                }
+            }
+        }
+        // Components numbered in the order of their smallest tet id.
+        let mut comp = vec![u32::MAX; cap];
+        let mut outside = vec![];
+        let mut n_comp = 0u32;
+        for t in 0..cap as u32 {
+            if !self.dt.is_alive(t) {
+                continue;
+            }
+            let r = uf.find(t) as usize;
+            if comp[r] == u32::MAX {
+                comp[r] = n_comp;
+                n_comp += 1;
+                outside.push(false);
+            }
+            let c = comp[r];
+            comp[t as usize] = c;
+            if !self.dt.is_finite(t) {
+                outside[c as usize] = true; // touches the hull
+            }
+        }
+        (comp, outside)
     }
 }

@@ -4,7 +4,6 @@
 
 mod domain;
 pub mod existing;
-pub mod facet_mesh;
 mod mark;
 mod output;
 mod quality;
@@ -190,6 +189,10 @@ pub struct Report {
     pub n_acute_angles: usize,
     /// Tets left violating a bound because they are within the influence of an acute angle.
     pub n_bad_near_acute: usize,
+    /// Tets whose region (or inside/outside status) the re-marking after a refinement pass
+    /// corrected: the labels tets inherit through cavities leaked across the boundary (a
+    /// cavity that crosses a subfacet for a moment). 0 on every acute-free model.
+    pub n_relabelled: usize,
     /// Whether every bound holds everywhere it is enforced (false when a budget stopped it).
     pub complete: bool,
     /// Why refinement stopped early, if it did.
@@ -234,6 +237,17 @@ fn tet_tags(dom: &domain::Domain) -> Vec<u32> {
             } else {
                 u32::MAX
             }
+        })
+        .collect()
+}
+
+/// The region of every tet slot as the output would give it: its attribute, None outside the
+/// domain (and for dead slots).
+fn tet_labels(dom: &domain::Domain, regions: &mark::Regions) -> Vec<Option<i32>> {
+    (0..dom.dt.tet_capacity() as u32)
+        .map(|t| {
+            let tag = if dom.dt.is_alive(t) { dom.dt.tag(t) } else { 0 };
+            (tag != 0).then(|| regions.attribute[tag as usize])
         })
         .collect()
 }
@@ -287,41 +301,22 @@ fn mesh_domain(
             &auto
         }
     };
-    let mut stop_reason = None;
-    let mut blocked = FxHashSet::default();
+    let mut passes = Passes::default();
     if params.refine {
-        let mut noop = |_: f64, _: usize| true;
-        let progress: &mut dyn FnMut(f64, usize) -> bool = match progress {
-            Some(p) => p,
-            None => &mut noop,
+        let mut ctx = PassContext {
+            input,
+            params,
+            spacing,
+            unseeded,
+            budget: &mut budget,
         };
-        let max_v = params.max_vertices.max(1) as f64;
-        let mut on_step = |n: usize| progress((n as f64 / max_v).min(1.0), n);
-        for _pass in 0..MAX_PASSES {
-            let before = dom.dt.num_vertices();
-            dom.created_log.clear();
-            let mut r = quality::Refiner::new(&mut dom, params, spacing, &regions);
-            r.run(&mut on_step)?;
-            stop_reason = r.stop_reason.take();
-            blocked.extend(r.blocked_by_small_angle.drain());
-            // A boundary split can delete a subfacet of another facet for a moment, letting
-            // region labels leak across it: check the whole boundary, re-mark from the seeds
-            // and look at every tet again until a pass changes nothing.
-            let refined = dom.dt.num_vertices();
-            let tags = tet_tags(&dom);
-            dom.recover_boundary(&mut budget)?;
-            regions = dom.mark_domain(input, unseeded)?;
-            if stop_reason.is_some() || dom.dt.num_vertices() == before {
-                break;
-            }
-            // Every tet was classified when it was made and the queues are empty: when the
-            // check and the re-marking changed nothing, another pass would only meet the
-            // tets already left alone.
-            if dom.dt.num_vertices() == refined && tet_tags(&dom) == tags {
-                break;
-            }
-        }
+        passes = refine_passes(&mut dom, &mut ctx, &mut regions, progress)?;
     }
+    let Passes {
+        mut stop_reason,
+        blocked,
+        n_relabelled,
+    } = passes;
     let seconds_refinement = start.elapsed().as_secs_f64() - seconds_recovery;
     let mesh = dom.to_mesh(&regions);
     let near_acute = |t: &[u32; 4]| {
@@ -333,6 +328,7 @@ fn mesh_domain(
     report.seconds_refinement = seconds_refinement;
     report.seconds_total = start.elapsed().as_secs_f64();
     report.n_acute_angles = dom.acute_vertices.len();
+    report.n_relabelled = n_relabelled;
     report.complete = stop_reason.is_none() && (bad_elsewhere == 0 || !params.refine);
     if params.refine && stop_reason.is_none() && bad_elsewhere > 0 {
         stop_reason = Some(format!(
@@ -341,4 +337,74 @@ fn mesh_domain(
     }
     report.stop_reason = stop_reason;
     Ok((mesh, report))
+}
+
+/// What the refinement passes leave for the report.
+#[derive(Default)]
+struct Passes {
+    /// Why refinement stopped early, if it did.
+    stop_reason: Option<String>,
+    /// Bad tets left within a small angle's influence (sorted vertex quadruples).
+    blocked: FxHashSet<[u32; 4]>,
+    /// Tets whose region the re-marking after a pass corrected (`Report::n_relabelled`).
+    n_relabelled: usize,
+}
+
+/// The inputs of [`refine_passes`] that stay fixed across passes.
+struct PassContext<'a> {
+    input: &'a PlcInput,
+    params: &'a Params,
+    spacing: &'a dyn Spacing,
+    unseeded: Unseeded,
+    budget: &'a mut usize,
+}
+
+/// Runs refinement passes (the bad-tet queues, then a whole-boundary check and re-marking of
+/// the regions, `regions` updated) until one changes nothing; see ARCHITECTURE.md for why the
+/// re-marking stays.
+fn refine_passes(
+    dom: &mut domain::Domain,
+    ctx: &mut PassContext,
+    regions: &mut mark::Regions,
+    progress: Option<Progress>,
+) -> Result<Passes, MeshError> {
+    let mut out = Passes::default();
+    let mut noop = |_: f64, _: usize| true;
+    let progress: &mut dyn FnMut(f64, usize) -> bool = match progress {
+        Some(p) => p,
+        None => &mut noop,
+    };
+    let max_v = ctx.params.max_vertices.max(1) as f64;
+    let mut on_step = |n: usize| progress((n as f64 / max_v).min(1.0), n);
+    for _pass in 0..MAX_PASSES {
+        let before = dom.dt.num_vertices();
+        dom.created_log.clear();
+        let mut r = quality::Refiner::new(dom, ctx.params, ctx.spacing, regions);
+        r.run(&mut on_step)?;
+        out.stop_reason = r.stop_reason.take();
+        out.blocked.extend(r.blocked_by_small_angle.drain());
+        // A boundary split can delete a subfacet of another facet for a moment, letting
+        // region labels leak across it: check the whole boundary, re-mark from the seeds
+        // and look at every tet again until a pass changes nothing.
+        let refined = dom.dt.num_vertices();
+        let tags = tet_tags(dom);
+        let labels = tet_labels(dom, regions);
+        dom.recover_boundary(ctx.budget)?;
+        *regions = dom.mark_domain(ctx.input, ctx.unseeded)?;
+        out.n_relabelled += labels
+            .iter()
+            .zip(tet_labels(dom, regions))
+            .filter(|(old, new)| **old != *new)
+            .count();
+        if out.stop_reason.is_some() || dom.dt.num_vertices() == before {
+            break;
+        }
+        // Every tet was classified when it was made and the queues are empty: when the
+        // check and the re-marking changed nothing, another pass would only meet the
+        // tets already left alone.
+        if dom.dt.num_vertices() == refined && tet_tags(dom) == tags {
+            break;
+        }
+    }
+    Ok(out)
 }
