@@ -233,6 +233,7 @@ mod tests {
             ("max_tries", 7.0),
             ("refine", 0.0),
             ("small_angle_reach", 2.0),
+            ("improve", 0.0),
         ];
         assert_eq!(values.len(), PARAM_NAMES.len());
         for (name, v) in values {
@@ -242,6 +243,8 @@ mod tests {
         assert_eq!(p.size_factor, 2.5);
         assert_eq!(p.seed, 42);
         assert!(!p.refine);
+        assert!(!p.improve);
+        assert!(set_param(&mut p, "improve", 0.5).is_err());
     }
 
     #[test]

@@ -104,7 +104,7 @@ fn segment_of(w: &Work, n_input: usize, segs: &[[u32; 2]]) -> Vec<u32> {
             }
         }
     }
-    for v in n_input..w.pos.len() {
+    for (v, slot) in out.iter_mut().enumerate().skip(n_input) {
         if w.bstar[v].is_empty() {
             continue;
         }
@@ -129,7 +129,7 @@ fn segment_of(w: &Work, n_input: usize, segs: &[[u32; 2]]) -> Vec<u32> {
                 }
             }
         }
-        out[v] = best.1;
+        *slot = best.1;
     }
     out
 }
@@ -187,9 +187,9 @@ pub(crate) fn on_hull(w: &Work, v: u32, faces: &mut Vec<[u32; 3]>) -> bool {
 pub(crate) fn classify(w: &mut Work, input: Option<&PlcInput>) -> (Vec<Constraint>, Vec<DVec3>) {
     let n = w.pos.len();
     let mut cons = vec![Constraint::Free; n];
-    for v in 0..n {
+    for (v, c) in cons.iter_mut().enumerate() {
         if w.star[v].is_empty() || !w.bstar[v].is_empty() {
-            cons[v] = Constraint::Fixed;
+            *c = Constraint::Fixed;
         }
     }
     let Some(input) = input else {

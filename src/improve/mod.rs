@@ -250,7 +250,7 @@ pub fn check_no_degenerate(mesh: &TetMesh) -> Result<(), MeshError> {
             return Err(MeshError::DegenerateTet {
                 index: i,
                 vertices: *t,
-                points: p,
+                points: Box::new(p),
                 inverted: o < 0.0,
             });
         }

@@ -139,7 +139,7 @@ impl Improver {
             }
             let d = min_norm(&grads);
             let dl = d.length();
-            if !(dl * scale > 1e-9) {
+            if dl * scale <= 1e-9 || !dl.is_finite() {
                 break;
             }
             let dir = cons.project(d / dl);
@@ -161,7 +161,7 @@ impl Improver {
                 break;
             }
         }
-        if !(qx > q0 + SMOOTH_GAIN) || !self.valid_move(&star, v, x) {
+        if qx <= q0 + SMOOTH_GAIN || qx.is_nan() || !self.valid_move(&star, v, x) {
             return false;
         }
         self.w.pos[v as usize] = x;

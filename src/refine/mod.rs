@@ -225,7 +225,7 @@ pub enum MeshError {
         /// Its index in the output's tets.
         index: usize,
         vertices: [u32; 4],
-        points: [DVec3; 4],
+        points: Box<[DVec3; 4]>,
         inverted: bool,
     },
 }
@@ -257,7 +257,7 @@ impl std::fmt::Display for MeshError {
                         "flat (zero volume)"
                     }
                 )?;
-                for p in points {
+                for p in points.iter() {
                     write!(f, " ({}, {}, {})", p.x, p.y, p.z)?;
                 }
                 Ok(())
