@@ -304,14 +304,16 @@ sm_status sm_add_region(sm_mesher *m,
 /**
  * Sets a refinement parameter by name: "rho0" (radius-edge bound R/L, >= 0.7, default 2),
  * "sigma0" (sliver bound V/L^3 in [0, 0.1179), default 0.02; 0 = off), "min_dihedral" (degrees
- * in [0, 70.5): tets with a smaller dihedral angle count as slivers, default 15; 0 = off),
+ * in [0, 70.5): tets with a smaller dihedral angle count as slivers, default 18; 0 = off),
  * "delta" (picking-ball factor in (0, 1), default 0.3), "b" (small-sliver radius factor > 0,
  * default 4), "size_factor" or "B" (R/f(c) bound > 0, default 1), "seed" (whole number,
  * default 1), "max_vertices" (whole number, at least 4; refinement stops there, reporting
  * complete = 0), "max_tries" (whole number, at least 1), "refine" (1, or 0 for boundary
  * recovery only), "small_angle_reach" (> 0, default infinity: how far, in protecting-ball
  * radii, the influence of a vertex where segments meet below 60 degrees reaches along its
- * segments and facets; 2 to 8 leave fewer bad tets there for more vertices and time).
+ * segments and facets; 2 to 8 leave fewer bad tets there for more vertices and time),
+ * "improve" (1, the default: flips and smoothing after refinement; 0 keeps the Delaunay
+ * mesh, removing only flat or inverted tets).
  * An unknown name or out-of-range value gives `SM_ERR_INVALID_ARGUMENT`; `sm_last_error`
  * says why (and lists the valid names).
  *

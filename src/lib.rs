@@ -3,6 +3,7 @@
 //! Layers, top to bottom (each knows only the ones below it):
 //! `ffi` (C ABI) → `api` (safe Rust API) → `io` (file formats) → `plc` (input validation)
 //! → `refine` (Li's REMOVE-SLIVER) → `delaunay` (3D kernel) → `geom` (exact predicates, measures).
+//! `improve` (flips, smoothing) works on refine's output mesh.
 //! `mesh` holds the output model shared by writers and meshers. See ARCHITECTURE.md.
 
 #![deny(clippy::undocumented_unsafe_blocks)]
@@ -12,6 +13,7 @@ pub mod cdt;
 pub mod delaunay;
 pub mod ffi;
 pub mod geom;
+pub mod improve;
 pub mod io;
 pub mod mesh;
 pub mod plc;

@@ -231,8 +231,11 @@ fn acute_models_terminate_and_meet_bounds_away_from_small_angles() {
                 TetQuality::of(a, b, c, d).sigma < 1e-9
             })
             .count();
-        let allowed = if ["off/part.off", "off/rotor.off"].contains(&rel) {
-            5
+        // (refinement alone: with min_dihedral 18, the default since issue 12, rotor has 13 and
+        // spool 2; the improvement pass every API/CLI output goes through leaves none with
+        // orient3d <= 0 and re-shapes the rest, tests/improve.rs)
+        let allowed = if ["off/part.off", "off/rotor.off", "off/spool.off"].contains(&rel) {
+            20
         } else {
             0
         };

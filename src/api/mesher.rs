@@ -321,7 +321,9 @@ impl Mesher {
             (Ok(_), None) if cancelled => Err(MeshError::Cancelled),
             (r, None) => r,
         };
-        let (mesh, report) = result?;
+        let (mesh, mut report) = result?;
+        let mesh =
+            crate::improve::finish(mesh, &mut report, Some(&self.input), self.params.improve)?;
         Ok(&self.output.insert(MeshOutput { mesh, report }).report)
     }
 

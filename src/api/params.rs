@@ -20,6 +20,7 @@ pub const PARAM_NAMES: &[&str] = &[
     "max_tries",
     "refine",
     "small_angle_reach",
+    "improve",
 ];
 
 /// Smallest accepted `rho0` (the refiner's own limit, `Params::check`).
@@ -38,7 +39,8 @@ const MAX_EXACT_INT: f64 = 9_007_199_254_740_992.0; // 2^53
 /// `sigma0` (in [0, 0.1179): 0 turns the sigma test off), `min_dihedral` (degrees, in
 /// [0, 70.5): 0 turns the angle test off), `delta` (in (0, 1)), `b` (> 0), `size_factor` or `B`
 /// (> 0), `seed` (integer in [0, 2^53]), `max_vertices` (integer >= 4), `max_tries`
-/// (integer >= 1), `refine` (0 or 1), `small_angle_reach` (> 0, may be infinite). Integer
+/// (integer >= 1), `refine` (0 or 1), `small_angle_reach` (> 0, may be infinite), `improve`
+/// (0 or 1). Integer
 /// parameters must be given as whole numbers.
 /// The result also passes `Params::check` (the refiner's own validation), so a value accepted
 /// here is never refused by `refine`.
@@ -115,6 +117,18 @@ fn set_unchecked(params: &mut Params, name: &str, value: f64) -> Result<(), Erro
             }
             params.small_angle_reach = value;
         }
+        "improve" => {
+            params.improve = match value {
+                0.0 => false,
+                1.0 => true,
+                _ => {
+                    return invalid(format!(
+                        "improve = {value}: must be 1 (flips and smoothing after refinement) \
+                         or 0 (keep the Delaunay mesh; only flat or inverted tets are removed)"
+                    ))
+                }
+            }
+        }
         "refine" => {
             params.refine = match value {
                 0.0 => false,
@@ -150,6 +164,7 @@ pub fn get_param(params: &Params, name: &str) -> Result<f64, Error> {
         "max_vertices" => params.max_vertices as f64,
         "max_tries" => params.max_tries as f64,
         "refine" => f64::from(u8::from(params.refine)),
+        "improve" => f64::from(u8::from(params.improve)),
         "small_angle_reach" => params.small_angle_reach,
         _ => {
             return invalid(format!(
@@ -218,6 +233,7 @@ mod tests {
             ("max_tries", 7.0),
             ("refine", 0.0),
             ("small_angle_reach", 2.0),
+            ("improve", 0.0),
         ];
         assert_eq!(values.len(), PARAM_NAMES.len());
         for (name, v) in values {
@@ -227,6 +243,8 @@ mod tests {
         assert_eq!(p.size_factor, 2.5);
         assert_eq!(p.seed, 42);
         assert!(!p.refine);
+        assert!(!p.improve);
+        assert!(set_param(&mut p, "improve", 0.5).is_err());
     }
 
     #[test]

@@ -2,6 +2,7 @@
 
 use indicatif::{ProgressBar, ProgressStyle};
 use slivermesh::geom::TetQuality;
+use slivermesh::improve;
 use slivermesh::io::{self, CellField, ReadOptions};
 use slivermesh::mesh::TetMesh;
 use slivermesh::plc::{Facet, PlcInput, Region};
@@ -43,12 +44,17 @@ pub struct MeshOptions {
     /// Keep .off/.stl/.ply/.obj faces as separate facets instead of merging coplanar ones.
     #[arg(long)]
     pub no_merge: bool,
+    /// Keep the refinement's Delaunay mesh: no flips or smoothing afterwards (flat or
+    /// inverted tets are still removed; the report says whether the output is Delaunay).
+    #[arg(long)]
+    pub no_improve: bool,
 }
 
 impl MeshOptions {
     fn params(&self) -> Params {
         let mut p = Params {
             refine: !self.no_refine,
+            improve: !self.no_improve,
             ..Params::default()
         };
         if let Some(v) = self.rho {
@@ -91,7 +97,12 @@ pub fn run_mesh(
         .is_some_and(|e| e.eq_ignore_ascii_case("mesh"));
     let (mesh, report) = if is_mesh {
         let existing = io::read_mesh(input).map_err(|e| e.to_string())?;
-        refine::existing::remove_slivers(&existing, &params).map_err(|e| e.to_string())?
+        let (mesh, mut report) =
+            refine::existing::remove_slivers(&existing, &params).map_err(|e| e.to_string())?;
+        // The existing mesh's boundary stays as it is (no facet description to move within).
+        let mesh =
+            improve::finish(mesh, &mut report, None, params.improve).map_err(|e| e.to_string())?;
+        (mesh, report)
     } else {
         let merge = !opts.no_merge && io::is_surface_file(input);
         let plc = io::read_plc(
@@ -101,7 +112,10 @@ pub fn run_mesh(
             },
         )
         .map_err(|e| e.to_string())?;
-        mesh_with_progress(&plc, &params, spacing)?
+        let (mesh, mut report) = mesh_with_progress(&plc, &params, spacing)?;
+        let mesh = improve::finish(mesh, &mut report, Some(&plc), params.improve)
+            .map_err(|e| e.to_string())?;
+        (mesh, report)
     };
     finish(&mesh, &report, output, stats_json, quality_svg)
 }
@@ -248,7 +262,9 @@ pub fn run_demo() -> Result<(), String> {
     let plc = demo_model();
     let f = FnSpacing(|p: DVec3| 0.02 + 0.1 * p.length());
     let params = Params::default();
-    let (mesh, report) = mesh_with_progress(&plc, &params, Some(&f))?;
+    let (mesh, mut report) = mesh_with_progress(&plc, &params, Some(&f))?;
+    let mesh = improve::finish(mesh, &mut report, Some(&plc), params.improve)
+        .map_err(|e| e.to_string())?;
     finish(
         &mesh,
         &report,

@@ -99,7 +99,9 @@ impl From<Error> for FfiError {
             Error::Mesh(MeshError::InvalidInput(_)) => SM_ERR_INVALID_INPUT,
             Error::Mesh(MeshError::BadSpacing { .. }) => SM_ERR_SPACING,
             Error::Mesh(MeshError::Cancelled) => SM_ERR_CANCELLED,
-            Error::Mesh(MeshError::Internal(_)) => SM_ERR_INTERNAL,
+            Error::Mesh(MeshError::Internal(_) | MeshError::DegenerateTet { .. }) => {
+                SM_ERR_INTERNAL
+            }
             Error::NotRefined => SM_ERR_NOT_REFINED,
             Error::Io(_) => SM_ERR_IO,
         };

@@ -51,6 +51,9 @@ pub struct Params {
     /// Smaller values (2 to 8) leave fewer bad tets next to small angles, at the price of more
     /// vertices and time on some models (docs/parameters.md).
     pub small_angle_reach: f64,
+    /// Improve the mesh after refinement (`crate::improve`: flips, edge removal, smoothing).
+    /// False keeps the refinement's Delaunay mesh, with only flat or inverted tets removed.
+    pub improve: bool,
 }
 
 impl Default for Params {
@@ -58,7 +61,7 @@ impl Default for Params {
         Params {
             rho0: 2.0,
             sigma0: 0.02,
-            min_dihedral: 15.0,
+            min_dihedral: 18.0,
             delta: 0.3,
             b: 4.0,
             size_factor: 1.0,
@@ -67,6 +70,7 @@ impl Default for Params {
             max_tries: 20,
             refine: true,
             small_angle_reach: f64::INFINITY,
+            improve: true,
         }
     }
 }
@@ -197,6 +201,14 @@ pub struct Report {
     pub complete: bool,
     /// Why refinement stopped early, if it did.
     pub stop_reason: Option<String>,
+    /// Whether the output is the refinement's Delaunay mesh (false once improvement changed it).
+    pub delaunay: bool,
+    /// Smallest and largest dihedral angle before improvement, degrees.
+    pub dihedral_before_improve_deg: [f64; 2],
+    /// Time spent in the improvement pass (included in `seconds_total`).
+    pub seconds_improvement: f64,
+    /// What the improvement pass did.
+    pub improvement: crate::improve::Stats,
 }
 
 /// Why meshing failed.
@@ -210,6 +222,15 @@ pub enum MeshError {
     Cancelled,
     /// A bug: an internal invariant failed.
     Internal(String),
+    /// A tet of the result is flat or inverted (exact orientation <= 0) and could not be
+    /// removed: the mesh is not returned.
+    DegenerateTet {
+        /// Its index in the output's tets.
+        index: usize,
+        vertices: [u32; 4],
+        points: Box<[DVec3; 4]>,
+        inverted: bool,
+    },
 }
 
 impl std::fmt::Display for MeshError {
@@ -223,6 +244,27 @@ impl std::fmt::Display for MeshError {
             ),
             MeshError::Cancelled => write!(f, "cancelled by the progress callback"),
             MeshError::Internal(m) => write!(f, "internal error: {m}"),
+            MeshError::DegenerateTet {
+                index,
+                vertices,
+                points,
+                inverted,
+            } => {
+                write!(
+                    f,
+                    "output tet {index} (vertices {vertices:?}, 0-based) is {}; no flip or \
+                     move removed it, so the mesh is not written. Its corners:",
+                    if *inverted {
+                        "inverted"
+                    } else {
+                        "flat (zero volume)"
+                    }
+                )?;
+                for p in points.iter() {
+                    write!(f, " ({}, {}, {})", p.x, p.y, p.z)?;
+                }
+                Ok(())
+            }
         }
     }
 }

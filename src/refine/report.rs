@@ -107,6 +107,25 @@ impl Report {
                 self.seconds_recovery, self.seconds_refinement
             ),
         );
+        row(
+            "time improvement (s)",
+            format!(
+                "{:.3} (flips {}, moves {}{})",
+                self.seconds_improvement,
+                self.improvement.edge_removals
+                    + self.improvement.face_removals
+                    + self.improvement.boundary_flips,
+                self.improvement.smoothed,
+                if self.delaunay { ", Delaunay" } else { "" }
+            ),
+        );
+        row(
+            "dihedral before improvement",
+            format!(
+                "{:.2} / {:.2}",
+                self.dihedral_before_improve_deg[0], self.dihedral_before_improve_deg[1]
+            ),
+        );
         row("max radius-edge rho", format!("{:.4}", self.max_rho));
         row("min sigma V/L^3", format!("{:.4}", self.min_sigma));
         row(

@@ -1,0 +1,324 @@
+//! Mesh improvement after refinement (Klingner & Shewchuk, "Aggressive tetrahedral mesh
+//! improvement", IMR 2007): on the final [`TetMesh`], with no knowledge of how it was made.
+//!
+//! - `quality`: the objective, the smallest sine of the dihedral angles (small for angles near
+//!   0 and near 180 degrees alike);
+//! - `topo`: the working mesh (tet slots, vertex stars, boundary triangles, edge rings);
+//! - `constraints`: how each vertex may move (input vertices never, segment vertices along the
+//!   segment, facet vertices in the facet's plane), and the flat facet patches;
+//! - `flips`: edge removal (3-2, 4-4 and larger rings by dynamic programming), the boundary 2-2
+//!   flip inside one facet patch, face removal (2-3);
+//! - `smooth`: non-smooth optimisation of the worst objective of a vertex's star.
+//!
+//! The driver takes the tets whose objective is below the target, worst first, and tries the
+//! best topological change touching the tet, then smoothing of its vertices. Every accepted
+//! change keeps every tet it makes positively oriented (exact `orient3d`) and strictly raises
+//! the worst objective of the tets it replaces or moves. Passes repeat until one changes
+//! nothing or the budget is spent. Order: by objective, then tet slot; no hashing decides
+//! anything, so the result is deterministic.
+
+mod constraints;
+mod flips;
+pub mod quality;
+mod smooth;
+mod topo;
+
+use crate::geom::{orient3d, TetQuality};
+use crate::mesh::TetMesh;
+use crate::plc::PlcInput;
+use crate::refine::{MeshError, Report};
+use constraints::Constraint;
+use glam::DVec3;
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+use topo::Work;
+
+/// What the improver is asked to do.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Options {
+    /// Full improvement (true) or only the removal of flat and inverted tets (false: the
+    /// refinement's Delaunay mesh is kept wherever it is valid).
+    pub improve: bool,
+    /// Tets whose smallest dihedral-angle sine is below sin(target_deg) are worked on.
+    pub target_deg: f64,
+    /// Passes at most over the bad tets.
+    pub max_passes: usize,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            improve: true,
+            target_deg: 26.0,
+            max_passes: 4,
+        }
+    }
+}
+
+/// What the improver did.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
+pub struct Stats {
+    pub edge_removals: usize,
+    pub face_removals: usize,
+    pub boundary_flips: usize,
+    pub smoothed: usize,
+    /// Vertices smoothing was tried on (`smoothed` of them moved).
+    pub smooth_attempts: usize,
+    pub passes: usize,
+    /// Tets flat or inverted (exact orient3d <= 0) before the pass.
+    pub degenerate_before: usize,
+    pub seconds: f64,
+    /// Of which planning topological changes, and smoothing.
+    pub seconds_plans: f64,
+    pub seconds_smooth: f64,
+}
+
+impl Stats {
+    /// Whether the mesh was changed at all.
+    pub fn changed(&self) -> bool {
+        self.edge_removals + self.face_removals + self.boundary_flips + self.smoothed > 0
+    }
+}
+
+pub(crate) struct Improver {
+    w: Work,
+    cons: Vec<Constraint>,
+    normals: Vec<DVec3>,
+    stats: Stats,
+}
+
+/// Objective above which a tet's float orientation is taken as its exact one (it is a ratio of
+/// the determinant to products of edge lengths and face areas: rounding cannot reach it).
+const SURELY_POSITIVE: f64 = 1e-6;
+
+/// Smoothings of one vertex per pass at most (each must gain, but gains can be small).
+const MAX_SMOOTHINGS: u8 = 2;
+
+/// Total order key of an objective value (worst first out of a max-heap of `Reverse`).
+fn key(q: f64) -> u64 {
+    let b = q.to_bits();
+    if b >> 63 == 1 {
+        !b
+    } else {
+        b | (1 << 63)
+    }
+}
+
+/// Improves `mesh`. `input` is the domain it was made from (keep mode): with it, boundary
+/// vertices move within their facet or segment and boundary triangles of one facet may flip;
+/// without it (an existing mesh) the boundary stays as it is.
+pub fn improve(mesh: &TetMesh, input: Option<&PlcInput>, opts: &Options) -> (TetMesh, Stats) {
+    let start = std::time::Instant::now();
+    let mut w = Work::new(mesh);
+    let (cons, normals) = constraints::classify(&mut w, input);
+    let mut im = Improver {
+        w,
+        cons,
+        normals,
+        stats: Stats::default(),
+    };
+    im.stats.degenerate_before = (0..im.w.tets.len())
+        .filter(|&t| im.w.q[t] < SURELY_POSITIVE && !im.w.positive(im.w.tets[t]))
+        .count();
+    if opts.improve || im.stats.degenerate_before > 0 {
+        im.run(opts);
+    }
+    im.stats.seconds = start.elapsed().as_secs_f64();
+    (im.w.to_mesh(), im.stats)
+}
+
+impl Improver {
+    fn bad(&self, t: u32, target: f64, improve: bool) -> bool {
+        let q = self.w.q[t as usize];
+        if improve && q < target {
+            return true;
+        }
+        // A clearly positive objective needs a clearly positive determinant: only tets near
+        // flat can have a float sign that differs from the exact one.
+        q < SURELY_POSITIVE && (q <= 0.0 || !self.w.positive(self.w.tets[t as usize]))
+    }
+
+    fn run(&mut self, opts: &Options) {
+        let target = opts.target_deg.to_radians().sin();
+        // Work budget: changes per pass, a multiple of the mesh size.
+        let budget = 4 * self.w.tets.len() + 1000;
+        // Change clock: a vertex's stamp is the last change around it; a tet that nothing
+        // helped is not tried again until one of its vertices is stamped later.
+        let mut clock: u32 = 1;
+        let mut stamp = vec![0u32; self.w.pos.len()];
+        let mut tried = vec![0u32; self.w.tets.len()];
+        for _ in 0..opts.max_passes {
+            self.stats.passes += 1;
+            let mut heap: BinaryHeap<Reverse<(u64, u32, [u32; 4])>> = BinaryHeap::new();
+            for t in 0..self.w.tets.len() as u32 {
+                if self.w.alive[t as usize] && self.bad(t, target, opts.improve) {
+                    heap.push(Reverse((
+                        key(self.w.q[t as usize]),
+                        t,
+                        self.w.tets[t as usize],
+                    )));
+                }
+            }
+            let mut changes = 0;
+            let mut smoothings = vec![0u8; self.w.pos.len()];
+            while let Some(Reverse((_, t, tv))) = heap.pop() {
+                if changes >= budget {
+                    break;
+                }
+                let ti = t as usize;
+                if !self.w.alive[ti] || self.w.tets[ti] != tv || !self.bad(t, target, opts.improve)
+                {
+                    continue;
+                }
+                if tried[ti] != 0 && tv.iter().all(|&v| stamp[v as usize] <= tried[ti]) {
+                    continue;
+                }
+                let mut touched: Vec<u32> = vec![];
+                let mut capped = false;
+                let t0 = std::time::Instant::now();
+                let plan = self.best_plan(t);
+                self.stats.seconds_plans += t0.elapsed().as_secs_f64();
+                if let Some(plan) = plan {
+                    touched = self.apply(plan);
+                    clock += 1;
+                    for &n in &touched {
+                        for v in self.w.tets[n as usize] {
+                            stamp[v as usize] = clock;
+                        }
+                    }
+                    for v in tv {
+                        stamp[v as usize] = clock;
+                    }
+                } else {
+                    for v in tv {
+                        if smoothings[v as usize] >= MAX_SMOOTHINGS {
+                            capped = true;
+                            continue;
+                        }
+                        smoothings[v as usize] += 1;
+                        self.stats.smooth_attempts += 1;
+                        let t0 = std::time::Instant::now();
+                        let ok = self.smooth(v);
+                        self.stats.seconds_smooth += t0.elapsed().as_secs_f64();
+                        if ok {
+                            touched = self.w.star[v as usize].clone();
+                            clock += 1;
+                            for &n in &touched {
+                                for u in self.w.tets[n as usize] {
+                                    stamp[u as usize] = clock;
+                                }
+                            }
+                            break;
+                        }
+                    }
+                }
+                if tried.len() < self.w.tets.len() {
+                    tried.resize(self.w.tets.len(), 0);
+                }
+                if touched.is_empty() {
+                    if !capped {
+                        tried[ti] = clock;
+                    }
+                    continue;
+                }
+                changes += 1;
+                for n in touched {
+                    tried[n as usize] = 0;
+                    if self.bad(n, target, opts.improve) {
+                        heap.push(Reverse((
+                            key(self.w.q[n as usize]),
+                            n,
+                            self.w.tets[n as usize],
+                        )));
+                    }
+                }
+            }
+            if changes == 0 {
+                break;
+            }
+        }
+    }
+}
+
+/// Fails with [`MeshError::DegenerateTet`] naming the first tet (in output order) that is
+/// not positively oriented by the exact `orient3d`.
+pub fn check_no_degenerate(mesh: &TetMesh) -> Result<(), MeshError> {
+    for (i, t) in mesh.tets.iter().enumerate() {
+        let p = t.map(|v| mesh.vertices[v as usize]);
+        let o = orient3d(p[0], p[1], p[2], p[3]);
+        if o <= 0.0 {
+            return Err(MeshError::DegenerateTet {
+                index: i,
+                vertices: *t,
+                points: Box::new(p),
+                inverted: o < 0.0,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Re-measures the shape figures of `report` (counts, rho, sigma, dihedral angles, tets below
+/// 5/10/15/20 degrees) on `mesh`; size figures stay those of the refinement.
+pub fn update_report(report: &mut Report, mesh: &TetMesh) {
+    let mut used = vec![false; mesh.vertices.len()];
+    mesh.tets
+        .iter()
+        .flatten()
+        .for_each(|&v| used[v as usize] = true);
+    report.n_vertices = used.iter().filter(|&&u| u).count();
+    report.n_tets = mesh.tets.len();
+    report.n_boundary_faces = mesh.boundary.len();
+    report.max_rho = 0.0;
+    report.min_sigma = f64::INFINITY;
+    report.min_dihedral_deg = 180.0;
+    report.max_dihedral_deg = 0.0;
+    report.tets_below_deg = [0; 4];
+    for t in &mesh.tets {
+        let p = t.map(|v| mesh.vertices[v as usize]);
+        let q = TetQuality::of(p[0], p[1], p[2], p[3]);
+        report.max_rho = report.max_rho.max(q.rho);
+        report.min_sigma = report.min_sigma.min(q.sigma);
+        report.min_dihedral_deg = report.min_dihedral_deg.min(q.min_dihedral);
+        report.max_dihedral_deg = report.max_dihedral_deg.max(q.max_dihedral);
+        for (k, limit) in [5.0, 10.0, 15.0, 20.0].iter().enumerate() {
+            if q.min_dihedral < *limit {
+                report.tets_below_deg[k] += 1;
+            }
+        }
+    }
+    if mesh.tets.is_empty() {
+        report.min_sigma = 0.0;
+        report.min_dihedral_deg = 0.0;
+    }
+}
+
+/// The step every mesher output goes through: improvement (or, with `improve` false, only
+/// the removal of flat and inverted tets), the check that no tet is degenerate, and the
+/// report's shape figures re-measured when the mesh changed.
+pub fn finish(
+    mesh: TetMesh,
+    report: &mut Report,
+    input: Option<&PlcInput>,
+    improve_on: bool,
+) -> Result<TetMesh, MeshError> {
+    let opts = Options {
+        improve: improve_on,
+        ..Options::default()
+    };
+    let before = (report.min_dihedral_deg, report.max_dihedral_deg);
+    let (out, stats) = improve(&mesh, input, &opts);
+    check_no_degenerate(&out)?;
+    if stats.changed() {
+        update_report(report, &out);
+    }
+    report.delaunay = !stats.changed();
+    report.dihedral_before_improve_deg = [before.0, before.1];
+    report.seconds_improvement = stats.seconds;
+    report.seconds_total += stats.seconds;
+    report.improvement = stats;
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,219 @@
+//! Vertex smoothing that maximises the worst objective of the vertex's star (Klingner &
+//! Shewchuk's non-smooth optimisation, after Freitag et al.): the search direction is the
+//! point of least norm in the convex hull of the gradients of the (nearly) worst tets, so a
+//! step along it raises all of them; the step is halved until the worst improves.
+//!
+//! A boundary vertex moves only within its constraint (facet plane or segment line): the
+//! displacement is projected, never the position, so the vertex keeps its offset from the
+//! plane to rounding. A move is kept only if every tet of the star stays positively oriented
+//! by the exact `orient3d` and every boundary triangle around the vertex keeps its side.
+
+use super::constraints::{on_hull, Constraint};
+use super::flips::MIN_GAIN;
+use super::quality::min_sin;
+use super::topo::DEAD;
+use super::Improver;
+use glam::DVec3;
+
+/// Gradient steps per smoothing of one vertex.
+const MAX_STEPS: usize = 8;
+/// Smallest gain of the star's worst objective for a move to be kept.
+const SMOOTH_GAIN: f64 = 1e-5;
+/// Tets within this of the worst are taken as active.
+const ACTIVE: f64 = 1e-3;
+
+/// The objective of star tet `t` (vertex ids) with vertex `v` at `x`.
+#[inline]
+fn q_at(pos: &[DVec3], t: &[u32; 4], v: u32, x: DVec3) -> f64 {
+    let p = t.map(|u| if u == v { x } else { pos[u as usize] });
+    min_sin(p[0], p[1], p[2], p[3])
+}
+
+/// The point of least norm in the convex hull of `g` (Frank-Wolfe; exact for two points).
+fn min_norm(g: &[DVec3]) -> DVec3 {
+    match g.len() {
+        0 => DVec3::ZERO,
+        1 => g[0],
+        _ => {
+            let mut x = g[0];
+            for _ in 0..32 {
+                // The vertex minimising <x, g_i>, then the exact line search on [x, g_i].
+                let s = *g
+                    .iter()
+                    .min_by(|a, b| a.dot(x).total_cmp(&b.dot(x)))
+                    .unwrap_or(&x);
+                let d = s - x;
+                let dd = d.length_squared();
+                if dd <= 0.0 {
+                    break;
+                }
+                let t = (-x.dot(d) / dd).clamp(0.0, 1.0);
+                if t <= 0.0 {
+                    break;
+                }
+                x += d * t;
+            }
+            x
+        }
+    }
+}
+
+impl Improver {
+    /// Worst objective of v's star with v at x.
+    fn star_min(&self, star: &[[u32; 4]], v: u32, x: DVec3) -> f64 {
+        star.iter()
+            .map(|t| q_at(&self.w.pos, t, v, x))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// Moves vertex v to raise the worst objective of its star; true when it moved.
+    pub(crate) fn smooth(&mut self, v: u32) -> bool {
+        let cons = self.cons[v as usize];
+        if cons == Constraint::Fixed {
+            return false;
+        }
+        let ids = self.w.star[v as usize].clone();
+        if ids.is_empty() {
+            return false;
+        }
+        if cons == Constraint::Free && on_hull(&self.w, v, &mut Vec::new()) {
+            // A hull face missing from the boundary list: the vertex is on the boundary.
+            self.cons[v as usize] = Constraint::Fixed;
+            return false;
+        }
+        let star: Vec<[u32; 4]> = ids.iter().map(|&t| self.w.tets[t as usize]).collect();
+        let x0 = self.w.p(v);
+        let q0 = ids
+            .iter()
+            .map(|&t| self.w.q[t as usize])
+            .fold(f64::INFINITY, f64::min);
+        // Length scale: the mean edge length at v.
+        let mut scale = 0.0;
+        let mut count = 0.0;
+        for t in &star {
+            for &u in t {
+                if u != v {
+                    scale += self.w.p(u).distance(x0);
+                    count += 1.0;
+                }
+            }
+        }
+        let scale = scale / count;
+        let mut x = x0;
+        let mut qx = q0;
+
+        // A first guess: the centroid of the neighbours (within the constraint).
+        let centroid = {
+            let mut c = DVec3::ZERO;
+            for t in &star {
+                for &u in t {
+                    if u != v {
+                        c += self.w.p(u);
+                    }
+                }
+            }
+            c / count
+        };
+        let guess = x0 + cons.project(centroid - x0);
+        let qg = self.star_min(&star, v, guess);
+        if qg > qx + MIN_GAIN {
+            x = guess;
+            qx = qg;
+        }
+
+        let h = 1e-7 * scale;
+        for _ in 0..MAX_STEPS {
+            let qs: Vec<f64> = star.iter().map(|t| q_at(&self.w.pos, t, v, x)).collect();
+            let worst = qs.iter().copied().fold(f64::INFINITY, f64::min);
+            let mut grads = vec![];
+            for (t, &q) in star.iter().zip(&qs) {
+                if q > worst + ACTIVE || grads.len() >= 6 {
+                    continue;
+                }
+                let g = DVec3::new(
+                    q_at(&self.w.pos, t, v, x + DVec3::X * h) - q,
+                    q_at(&self.w.pos, t, v, x + DVec3::Y * h) - q,
+                    q_at(&self.w.pos, t, v, x + DVec3::Z * h) - q,
+                ) / h;
+                grads.push(cons.project(g));
+            }
+            let d = min_norm(&grads);
+            let dl = d.length();
+            if dl * scale <= 1e-9 || !dl.is_finite() {
+                break;
+            }
+            let dir = cons.project(d / dl);
+            // First step: where the linear model of the worst tet gains 0.5 (capped).
+            let mut step = (0.5 / dl).min(0.3 * scale);
+            let mut moved = false;
+            for _ in 0..10 {
+                let y = x + dir * step;
+                let qy = self.star_min(&star, v, y);
+                if qy > qx + MIN_GAIN {
+                    x = y;
+                    qx = qy;
+                    moved = true;
+                    break;
+                }
+                step *= 0.5;
+            }
+            if !moved {
+                break;
+            }
+        }
+        if qx <= q0 + SMOOTH_GAIN || qx.is_nan() || !self.valid_move(&star, v, x) {
+            return false;
+        }
+        self.w.pos[v as usize] = x;
+        for (&t, tv) in ids.iter().zip(&star) {
+            self.w.q[t as usize] = q_at(&self.w.pos, tv, v, x);
+        }
+        self.stats.smoothed += 1;
+        true
+    }
+
+    /// Exact orientation of every star tet with v at x, and the boundary triangles' sides.
+    fn valid_move(&mut self, star: &[[u32; 4]], v: u32, x: DVec3) -> bool {
+        let old = self.w.pos[v as usize];
+        let mut side_ok = true;
+        for &bt in &self.w.bstar[v as usize] {
+            let patch = self.w.bpatch[bt as usize];
+            if patch == DEAD {
+                return false;
+            }
+            let n = self.normals[patch as usize];
+            let tri = self.w.btri[bt as usize];
+            let side = |y: DVec3| {
+                let [a, b, c] = tri.map(|u| if u == v { y } else { self.w.pos[u as usize] });
+                (b - a).cross(c - a).dot(n)
+            };
+            let (s0, s1) = (side(old), side(x));
+            if s0 == 0.0 || s0.signum() != s1.signum() || s1 == 0.0 {
+                side_ok = false;
+                break;
+            }
+        }
+        if !side_ok {
+            return false;
+        }
+        self.w.pos[v as usize] = x;
+        let ok = star.iter().all(|&t| self.w.positive(t));
+        self.w.pos[v as usize] = old;
+        ok
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn min_norm_of_two_and_three() {
+        let g = [DVec3::new(1.0, 1.0, 0.0), DVec3::new(-1.0, 1.0, 0.0)];
+        assert!((min_norm(&g) - DVec3::new(0.0, 1.0, 0.0)).length() < 1e-12);
+        let g = [DVec3::X, DVec3::Y, DVec3::Z];
+        assert!((min_norm(&g) - DVec3::splat(1.0 / 3.0)).length() < 1e-3);
+        let g = [DVec3::X, -DVec3::X];
+        assert!(min_norm(&g).length() < 1e-12);
+    }
+}

@@ -1,0 +1,319 @@
+use super::*;
+use crate::geom::orient3d;
+
+fn vol(m: &TetMesh) -> f64 {
+    m.tets
+        .iter()
+        .map(|t| {
+            let p = t.map(|v| m.vertices[v as usize]);
+            orient3d(p[0], p[1], p[2], p[3]) / 6.0
+        })
+        .sum()
+}
+
+fn min_q(m: &TetMesh) -> f64 {
+    m.tets
+        .iter()
+        .map(|t| {
+            let p = t.map(|v| m.vertices[v as usize]);
+            quality::min_sin(p[0], p[1], p[2], p[3])
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Three tets around the edge (a, b) = (0, 1): the 3-2 flip (edge removal) must turn them
+/// into two better ones.
+#[test]
+fn three_two_flip_removes_a_long_edge() {
+    let a = DVec3::new(0.0, 0.0, -1.0);
+    let b = DVec3::new(0.0, 0.0, 1.0);
+    let r: Vec<DVec3> = (0..3)
+        .map(|k| {
+            let t = k as f64 * std::f64::consts::TAU / 3.0;
+            DVec3::new(t.cos(), t.sin(), 0.0)
+        })
+        .collect();
+    let mut vertices = vec![a, b];
+    vertices.extend(&r);
+    let mut tets = vec![];
+    for i in 0..3u32 {
+        let (x, y) = (2 + i, 2 + (i + 1) % 3);
+        let mut t = [0, 1, x, y];
+        let p = t.map(|v| vertices[v as usize]);
+        if orient3d(p[0], p[1], p[2], p[3]) < 0.0 {
+            t.swap(2, 3);
+        }
+        tets.push(t);
+    }
+    // Stretch the edge so the three tets are needles around it.
+    vertices[0].z = -6.0;
+    vertices[1].z = 6.0;
+    let mesh = TetMesh {
+        vertices,
+        tets,
+        tet_regions: vec![3; 3],
+        ..Default::default()
+    };
+    let before = min_q(&mesh);
+    let (out, stats) = improve(&mesh, None, &Options::default());
+    assert_eq!(out.tets.len(), 2, "{stats:?}");
+    assert_eq!(stats.edge_removals, 1);
+    assert!(min_q(&out) > before);
+    assert!((vol(&out) - vol(&mesh)).abs() <= 1e-12 * vol(&mesh));
+    assert!(out.tet_regions.iter().all(|&r| r == 3));
+    check_no_degenerate(&out).unwrap();
+}
+
+/// A flat tet (four coplanar points) gets reported with its vertices and coordinates.
+#[test]
+fn degenerate_tet_is_named() {
+    let mesh = TetMesh {
+        vertices: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(1.0, 1.0, 0.0)],
+        tets: vec![[0, 1, 2, 3]],
+        tet_regions: vec![0],
+        ..Default::default()
+    };
+    let e = check_no_degenerate(&mesh).unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        msg.contains("[0, 1, 2, 3]") && msg.contains("(1, 1, 0)"),
+        "{msg}"
+    );
+    assert!(msg.contains("flat"), "{msg}");
+}
+
+/// An interior vertex pushed next to a face of its star is moved back by smoothing.
+#[test]
+fn smoothing_recentres_an_interior_vertex() {
+    // An octahedron around an interior vertex 6.
+    let mut vertices = vec![
+        DVec3::X,
+        -DVec3::X,
+        DVec3::Y,
+        -DVec3::Y,
+        DVec3::Z,
+        -DVec3::Z,
+        DVec3::new(0.5, 0.2, 0.1),
+    ];
+    let faces = [
+        [0, 2, 4],
+        [2, 1, 4],
+        [1, 3, 4],
+        [3, 0, 4],
+        [2, 0, 5],
+        [1, 2, 5],
+        [3, 1, 5],
+        [0, 3, 5],
+    ];
+    let mut tets = vec![];
+    let mut boundary = vec![];
+    for f in faces {
+        let mut t = [f[0], f[1], f[2], 6];
+        let p = t.map(|v: u32| vertices[v as usize]);
+        if orient3d(p[0], p[1], p[2], p[3]) < 0.0 {
+            t.swap(0, 1);
+        }
+        tets.push(t);
+        boundary.push(f);
+    }
+    let mesh = TetMesh {
+        vertices: vertices.clone(),
+        tets,
+        tet_regions: vec![0; 8],
+        boundary_markers: vec![1; 8],
+        boundary,
+    };
+    let before = min_q(&mesh);
+    let (out, stats) = improve(&mesh, None, &Options::default());
+    assert!(stats.smoothed >= 1, "{stats:?}");
+    assert!(min_q(&out) > before + 0.1, "{} -> {}", before, min_q(&out));
+    assert!(out.vertices[6].length() < 0.3, "{:?}", out.vertices[6]);
+    // Boundary vertices stay where they were.
+    vertices.truncate(6);
+    assert_eq!(&out.vertices[..6], &vertices[..]);
+    assert!((vol(&out) - vol(&mesh)).abs() <= 1e-12);
+    check_no_degenerate(&out).unwrap();
+}
+
+/// Same input, same output (no hashing decides anything).
+#[test]
+fn deterministic() {
+    let mut vertices = vec![];
+    for i in 0..4 {
+        for j in 0..4 {
+            for k in 0..4 {
+                let jitter = ((i * 7 + j * 13 + k * 29) % 11) as f64 * 0.02;
+                vertices.push(DVec3::new(i as f64 + jitter, j as f64, k as f64 - jitter));
+            }
+        }
+    }
+    let n = vertices.len();
+    let mut tets = vec![];
+    // A Kuhn triangulation of the grid cells (valid for the small jitter used).
+    let id = |i: usize, j: usize, k: usize| (i * 16 + j * 4 + k) as u32;
+    for i in 0..3 {
+        for j in 0..3 {
+            for k in 0..3 {
+                let c = [
+                    id(i, j, k),
+                    id(i + 1, j, k),
+                    id(i + 1, j + 1, k),
+                    id(i, j + 1, k),
+                    id(i, j, k + 1),
+                    id(i + 1, j, k + 1),
+                    id(i + 1, j + 1, k + 1),
+                    id(i, j + 1, k + 1),
+                ];
+                for t in [
+                    [0, 1, 2, 6],
+                    [0, 2, 3, 6],
+                    [0, 3, 7, 6],
+                    [0, 7, 4, 6],
+                    [0, 4, 5, 6],
+                    [0, 5, 1, 6],
+                ] {
+                    let mut tv = t.map(|x| c[x]);
+                    let p = tv.map(|v| vertices[v as usize]);
+                    if orient3d(p[0], p[1], p[2], p[3]) < 0.0 {
+                        tv.swap(0, 1);
+                    }
+                    tets.push(tv);
+                }
+            }
+        }
+    }
+    let mesh = TetMesh {
+        vertices,
+        tet_regions: vec![0; tets.len()],
+        tets,
+        ..Default::default()
+    };
+    assert_eq!(mesh.vertices.len(), n);
+    let opts = Options {
+        target_deg: 60.0,
+        ..Options::default()
+    };
+    let (a, sa) = improve(&mesh, None, &opts);
+    let (b, _) = improve(&mesh, None, &opts);
+    assert_eq!(a, b);
+    assert!(sa.changed());
+    assert!(min_q(&a) >= min_q(&mesh));
+    assert!((vol(&a) - vol(&mesh)).abs() <= 1e-9 * vol(&mesh));
+    check_no_degenerate(&a).unwrap();
+}
+
+/// A flat tet lying on a facet (two of its faces are the facet's triangles) is removed by the
+/// boundary 2-2 flip, with or without improvement, and the facet keeps its area and marker.
+#[test]
+fn flat_tet_on_a_facet_is_flipped_away() {
+    use crate::plc::Facet;
+    let vertices = vec![
+        DVec3::ZERO,
+        DVec3::X,
+        DVec3::new(1.0, 1.0, 0.0),
+        DVec3::Y,
+        DVec3::new(0.5, 0.5, 1.0),
+    ];
+    let orient = |mut t: [u32; 4]| {
+        let p = t.map(|v| vertices[v as usize]);
+        if orient3d(p[0], p[1], p[2], p[3]) < 0.0 {
+            t.swap(0, 1);
+        }
+        t
+    };
+    let facet = |ids: &[u32], marker| Facet {
+        polygons: vec![ids.to_vec()],
+        marker,
+        ..Default::default()
+    };
+    let input = PlcInput {
+        vertices: vertices.clone(),
+        facets: vec![
+            facet(&[0, 3, 2, 1], 7),
+            facet(&[0, 1, 4], 1),
+            facet(&[1, 2, 4], 1),
+            facet(&[2, 3, 4], 1),
+            facet(&[3, 0, 4], 1),
+        ],
+        ..Default::default()
+    };
+    let mesh = TetMesh {
+        vertices: vertices.clone(),
+        tets: vec![[0, 1, 2, 3], orient([0, 1, 3, 4]), orient([1, 2, 3, 4])],
+        tet_regions: vec![0; 3],
+        boundary: vec![
+            [0, 2, 1],
+            [0, 3, 2],
+            [0, 1, 4],
+            [1, 2, 4],
+            [2, 3, 4],
+            [3, 0, 4],
+        ],
+        boundary_markers: vec![7, 7, 1, 1, 1, 1],
+    };
+    assert!(check_no_degenerate(&mesh).is_err());
+    for improve_on in [false, true] {
+        let mut report = Report::default();
+        let out = finish(mesh.clone(), &mut report, Some(&input), improve_on).unwrap();
+        assert_eq!(out.tets.len(), 2, "{:?}", report.improvement);
+        assert_eq!(report.improvement.boundary_flips, 1);
+        assert!(!report.delaunay);
+        let mut base: Vec<[u32; 3]> = out
+            .boundary
+            .iter()
+            .zip(&out.boundary_markers)
+            .filter(|(_, &m)| m == 7)
+            .map(|(t, _)| topo::key3(*t))
+            .collect();
+        base.sort_unstable();
+        assert_eq!(base, vec![[0, 1, 3], [1, 2, 3]]);
+        // Oriented like before: normals still point down (out of the pyramid).
+        for (t, &m) in out.boundary.iter().zip(&out.boundary_markers) {
+            if m == 7 {
+                let [a, b, c] = t.map(|v| out.vertices[v as usize]);
+                assert!((b - a).cross(c - a).z < 0.0, "{t:?}");
+            }
+        }
+        assert!((vol(&out) - 1.0 / 3.0).abs() < 1e-12);
+    }
+    // Without the input description the boundary may not flip; here the interior 3-2 flip
+    // of edge 1-3 removes the flat tet instead, keeping the base's triangles.
+    let mut report = Report::default();
+    let out = finish(mesh.clone(), &mut report, None, true).unwrap();
+    assert_eq!(out.boundary, mesh.boundary);
+    assert_eq!(report.improvement.edge_removals, 1);
+    assert_eq!(out.tets.len(), 2);
+}
+
+/// A 2-3 flip: two tets sharing a face whose opposite vertices are far apart.
+#[test]
+fn two_three_flip() {
+    let vertices = vec![
+        DVec3::new(1.0, 0.0, 0.0),
+        DVec3::new(-0.5, 0.87, 0.0),
+        DVec3::new(-0.5, -0.87, 0.0),
+        DVec3::new(0.0, 0.0, 0.15),
+        DVec3::new(0.0, 0.0, -0.15),
+    ];
+    let mut tets = vec![[0, 1, 2, 3], [0, 2, 1, 4]];
+    for t in &mut tets {
+        let p = t.map(|v| vertices[v as usize]);
+        if orient3d(p[0], p[1], p[2], p[3]) < 0.0 {
+            t.swap(0, 1);
+        }
+    }
+    let w = Work::new(&TetMesh {
+        vertices,
+        tets,
+        tet_regions: vec![0, 0],
+        ..Default::default()
+    });
+    let im = Improver {
+        w,
+        cons: vec![Constraint::Fixed; 5],
+        normals: vec![],
+        stats: Stats::default(),
+    };
+    let plan = im.plan_face([0, 1, 2]).expect("2-3 flip improves");
+    assert!(plan.new_min > im.w.q[0].max(im.w.q[1]));
+}

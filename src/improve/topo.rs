@@ -1,0 +1,270 @@
+//! The improver's working mesh: tets in slots (a free list keeps ids stable and reuse
+//! deterministic), vertex stars, boundary triangles by sorted key, and the rings around edges.
+
+use super::quality::min_sin;
+use crate::geom::orient3d;
+use crate::mesh::TetMesh;
+use glam::DVec3;
+use rustc_hash::{FxHashMap, FxHashSet};
+
+pub(crate) const DEAD: u32 = u32::MAX;
+
+/// Sorted copy of a face's vertex ids (the boundary map's key).
+#[inline]
+pub(crate) fn key3(mut f: [u32; 3]) -> [u32; 3] {
+    f.sort_unstable();
+    f
+}
+
+pub(crate) struct Work {
+    pub pos: Vec<DVec3>,
+    pub tets: Vec<[u32; 4]>,
+    pub region: Vec<i32>,
+    pub alive: Vec<bool>,
+    free: Vec<u32>,
+    /// Alive tets around each vertex (order changes as tets come and go, deterministically).
+    pub star: Vec<Vec<u32>>,
+    /// Boundary triangles (oriented as given), their markers and facet patch
+    /// (`DEAD`: none known, so the triangle never moves or flips).
+    pub btri: Vec<[u32; 3]>,
+    pub bmarker: Vec<i32>,
+    pub bpatch: Vec<u32>,
+    /// Sorted triangle -> index into `btri`.
+    pub bmap: FxHashMap<[u32; 3], u32>,
+    /// Boundary triangles around each vertex.
+    pub bstar: Vec<Vec<u32>>,
+    /// Boundary edges (sorted pair, smaller id high) inside one facet patch: the only ones a
+    /// boundary flip may remove.
+    pub flat_edges: FxHashSet<u64>,
+    /// Objective (`quality::min_sin`) of every tet slot.
+    pub q: Vec<f64>,
+}
+
+/// The key of edge (a, b) in `Work::flat_edges`.
+#[inline]
+pub(crate) fn edge_key(a: u32, b: u32) -> u64 {
+    ((a.min(b) as u64) << 32) | a.max(b) as u64
+}
+
+/// The tets around an edge (a, b), in order: tet `tets[i]` is (a, b, ring[i], ring[i+1])
+/// positively oriented (indices mod the ring length when `closed`).
+pub(crate) struct Ring {
+    pub ring: Vec<u32>,
+    pub tets: Vec<u32>,
+    pub closed: bool,
+}
+
+/// Parity of the permutation taking `t` to `(p[0], p[1], p[2], p[3])` (all of t's vertices).
+pub(crate) fn even_perm(t: &[u32; 4], p: [u32; 4]) -> bool {
+    let idx = p.map(|v| t.iter().position(|&x| x == v).unwrap_or(0));
+    let mut inv = 0;
+    for i in 0..4 {
+        for j in i + 1..4 {
+            if idx[i] > idx[j] {
+                inv += 1;
+            }
+        }
+    }
+    inv % 2 == 0
+}
+
+impl Work {
+    pub fn new(mesh: &TetMesh) -> Work {
+        let n = mesh.vertices.len();
+        let mut w = Work {
+            pos: mesh.vertices.clone(),
+            tets: Vec::with_capacity(mesh.tets.len() + mesh.tets.len() / 8),
+            region: Vec::with_capacity(mesh.tets.len()),
+            alive: Vec::with_capacity(mesh.tets.len()),
+            free: vec![],
+            star: vec![Vec::new(); n],
+            btri: mesh.boundary.clone(),
+            bmarker: mesh.boundary_markers.clone(),
+            bpatch: vec![DEAD; mesh.boundary.len()],
+            bmap: FxHashMap::default(),
+            bstar: vec![Vec::new(); n],
+            flat_edges: FxHashSet::default(),
+            q: Vec::with_capacity(mesh.tets.len()),
+        };
+        let mut degree = vec![0u32; n];
+        mesh.tets
+            .iter()
+            .flatten()
+            .for_each(|&v| degree[v as usize] += 1);
+        for (s, &d) in w.star.iter_mut().zip(&degree) {
+            s.reserve_exact(d as usize + 4);
+        }
+        for (i, &t) in mesh.tets.iter().enumerate() {
+            w.add_tet(t, mesh.tet_regions.get(i).copied().unwrap_or(0));
+        }
+        w.bmap.reserve(mesh.boundary.len());
+        for (i, &f) in mesh.boundary.iter().enumerate() {
+            w.bmap.insert(key3(f), i as u32);
+            for v in f {
+                w.bstar[v as usize].push(i as u32);
+            }
+        }
+        w
+    }
+
+    pub fn p(&self, v: u32) -> DVec3 {
+        self.pos[v as usize]
+    }
+
+    pub fn points(&self, t: &[u32; 4]) -> [DVec3; 4] {
+        t.map(|v| self.pos[v as usize])
+    }
+
+    pub fn add_tet(&mut self, t: [u32; 4], region: i32) -> u32 {
+        let [a, b, c, d] = self.points(&t);
+        let q = min_sin(a, b, c, d);
+        let id = match self.free.pop() {
+            Some(id) => {
+                self.tets[id as usize] = t;
+                self.region[id as usize] = region;
+                self.alive[id as usize] = true;
+                self.q[id as usize] = q;
+                id
+            }
+            None => {
+                self.tets.push(t);
+                self.region.push(region);
+                self.alive.push(true);
+                self.q.push(q);
+                (self.tets.len() - 1) as u32
+            }
+        };
+        for v in t {
+            self.star[v as usize].push(id);
+        }
+        id
+    }
+
+    pub fn kill_tet(&mut self, id: u32) {
+        let t = self.tets[id as usize];
+        for v in t {
+            let s = &mut self.star[v as usize];
+            if let Some(k) = s.iter().position(|&x| x == id) {
+                s.swap_remove(k);
+            }
+        }
+        self.alive[id as usize] = false;
+        self.free.push(id);
+    }
+
+    pub fn is_boundary_face(&self, f: [u32; 3]) -> bool {
+        self.bmap.contains_key(&key3(f))
+    }
+
+    /// Replaces boundary triangle `i` by `f` (same marker and patch).
+    pub fn replace_btri(&mut self, i: u32, f: [u32; 3]) {
+        let old = self.btri[i as usize];
+        self.bmap.remove(&key3(old));
+        for v in old {
+            let s = &mut self.bstar[v as usize];
+            if let Some(k) = s.iter().position(|&x| x == i) {
+                s.swap_remove(k);
+            }
+        }
+        self.btri[i as usize] = f;
+        self.bmap.insert(key3(f), i);
+        for v in f {
+            self.bstar[v as usize].push(i);
+        }
+    }
+
+    /// Exact orientation test of a would-be tet.
+    pub fn positive(&self, t: [u32; 4]) -> bool {
+        let [a, b, c, d] = self.points(&t);
+        orient3d(a, b, c, d) > 0.0
+    }
+
+    /// The tets around edge (a, b) in ring order, or `None` when they do not form one
+    /// cycle or one path (a broken input).
+    pub fn ring(&self, a: u32, b: u32) -> Option<Ring> {
+        // (x, y, tet) with (a, b, x, y) positively ordered.
+        let mut links: Vec<(u32, u32, u32)> = Vec::with_capacity(12);
+        let (sa, sb) = (&self.star[a as usize], &self.star[b as usize]);
+        for &t in if sa.len() <= sb.len() { sa } else { sb } {
+            let tv = &self.tets[t as usize];
+            if !(tv.contains(&b) && tv.contains(&a)) {
+                continue;
+            }
+            let mut o = tv.iter().copied().filter(|&v| v != a && v != b);
+            let (x, y) = (o.next()?, o.next()?);
+            if even_perm(tv, [a, b, x, y]) {
+                links.push((x, y, t));
+            } else {
+                links.push((y, x, t));
+            }
+        }
+        let m = links.len();
+        if m == 0 {
+            return None;
+        }
+        // A start with no predecessor (a path); otherwise the smallest-id tet (a cycle).
+        let start = (0..m)
+            .find(|&i| !links.iter().any(|l| l.1 == links[i].0))
+            .unwrap_or(0);
+        let closed = links.iter().all(|l| links.iter().any(|k| k.1 == l.0));
+        let mut ring = vec![links[start].0];
+        let mut tets = Vec::with_capacity(m);
+        let mut cur = start;
+        loop {
+            tets.push(links[cur].2);
+            let y = links[cur].1;
+            if y == ring[0] && tets.len() < m {
+                return None; // several cycles
+            }
+            if tets.len() == m {
+                if closed {
+                    if y != ring[0] {
+                        return None;
+                    }
+                } else {
+                    ring.push(y);
+                }
+                break;
+            }
+            ring.push(y);
+            cur = links.iter().position(|l| l.0 == y)?;
+        }
+        if !closed && links.iter().any(|l| l.1 == ring[0]) {
+            return None;
+        }
+        Some(Ring { ring, tets, closed })
+    }
+
+    /// The (at most two) alive tets holding face `f`.
+    pub fn face_tets(&self, f: [u32; 3]) -> ([u32; 2], usize) {
+        let mut out = [DEAD; 2];
+        let mut n = 0;
+        for &t in &self.star[f[0] as usize] {
+            let tv = &self.tets[t as usize];
+            if tv.contains(&f[1]) && tv.contains(&f[2]) {
+                if n < 2 {
+                    out[n] = t;
+                }
+                n += 1;
+            }
+        }
+        (out, n)
+    }
+
+    /// Back to a `TetMesh`: alive tets in slot order, boundary triangles in their order.
+    pub fn to_mesh(&self) -> TetMesh {
+        let mut m = TetMesh {
+            vertices: self.pos.clone(),
+            boundary: self.btri.clone(),
+            boundary_markers: self.bmarker.clone(),
+            ..Default::default()
+        };
+        for (i, t) in self.tets.iter().enumerate() {
+            if self.alive[i] {
+                m.tets.push(*t);
+                m.tet_regions.push(self.region[i]);
+            }
+        }
+        m
+    }
+}

@@ -1,0 +1,149 @@
+//! The improvement pass (issue 12) on the shared models, through the API in keep mode with
+//! default spacing: no flat or inverted tet, the boundary still the input surface (area per
+//! marker and volume to 1e-9, every boundary vertex on it), regions kept, quality bounds on the
+//! acute-free models, `improve = 0` keeps the Delaunay mesh, and determinism.
+
+mod common;
+use common::*;
+use slivermesh::api::Mesher;
+use slivermesh::geom::TetQuality;
+use slivermesh::improve;
+use slivermesh::TetMesh;
+
+fn mesh(rel: &str, improve_on: bool) -> (TetMesh, slivermesh::refine::Report) {
+    let mut m = Mesher::from_plc(read_model(rel)).unwrap();
+    m.set_param("improve", if improve_on { 1.0 } else { 0.0 })
+        .unwrap();
+    m.refine().unwrap_or_else(|e| panic!("{rel}: {e}"));
+    let out = m.take_output().unwrap();
+    (out.mesh, out.report)
+}
+
+/// Everything the pass must keep, and no degenerate tet.
+fn check_kept(rel: &str, m: &TetMesh) {
+    let input = read_model(rel);
+    check_orientation(m);
+    improve::check_no_degenerate(m).unwrap();
+    check_boundary_faces_are_tet_faces(m);
+    let want = facet_area_by_marker(&input);
+    let got = boundary_area_by_marker(m);
+    assert_eq!(want.len(), got.len(), "{rel}: markers");
+    for (mk, a) in &want {
+        let g = got.get(mk).copied().unwrap_or(0.0);
+        assert!(
+            rel_close(g, *a, 1e-9),
+            "{rel}: marker {mk}: area {g}, facets {a}"
+        );
+    }
+    check_on_input_surface(rel, &input, m);
+    if let Some(v) = enclosed_volume(&input) {
+        let vol = total_volume(m);
+        assert!(rel_close(vol, v, 1e-9), "{rel}: volume {vol}, expected {v}");
+    }
+}
+
+fn dihedral_range(m: &TetMesh) -> (f64, f64) {
+    m.tets.iter().fold((180.0f64, 0.0f64), |(lo, hi), t| {
+        let p = t.map(|v| m.vertices[v as usize]);
+        let q = TetQuality::of(p[0], p[1], p[2], p[3]);
+        (lo.min(q.min_dihedral), hi.max(q.max_dihedral))
+    })
+}
+
+const ACUTE_FREE: &[&str] = &[
+    "poly/cube.poly",
+    "poly/lshape.poly",
+    "poly/stairs.poly",
+    "poly/box_with_cavity.poly",
+    "poly/two_materials.poly",
+    "poly/drilled_block.poly",
+    "poly/thin_plate.poly",
+    "poly/tetgen_example.poly",
+    "off/cube.off",
+    "off/cross.off",
+];
+
+#[test]
+fn acute_free_models_reach_25_to_160_degrees() {
+    for &rel in ACUTE_FREE {
+        let (m, r) = mesh(rel, true);
+        check_kept(rel, &m);
+        let (lo, hi) = dihedral_range(&m);
+        assert!(
+            lo >= 25.0 && hi <= 160.0,
+            "{rel}: dihedral {lo:.3} / {hi:.3}"
+        );
+        assert!(
+            (r.min_dihedral_deg - lo).abs() < 1e-9,
+            "{rel}: report {}",
+            r.min_dihedral_deg
+        );
+        assert_eq!(r.n_tets, m.tets.len());
+    }
+}
+
+#[test]
+fn regions_keep_their_volume() {
+    let (m, _) = mesh("poly/two_materials.poly", true);
+    assert!(rel_close(region_volume(&m, 1), 1.0, 1e-9));
+    assert!(rel_close(region_volume(&m, 2), 1.0, 1e-9));
+}
+
+/// improve = 0: the refinement's Delaunay mesh as it is (when it has no flat tet), reported so.
+#[test]
+fn no_improve_keeps_the_delaunay_mesh() {
+    for rel in ["poly/two_materials.poly", "off/cross.off"] {
+        let (m, r) = mesh(rel, false);
+        check_delaunay(&m);
+        check_kept(rel, &m);
+        assert!(r.delaunay, "{rel}");
+        let (m2, r2) = mesh(rel, true);
+        assert!(!r2.delaunay || m2 == m, "{rel}");
+        assert!(r2.min_dihedral_deg >= r.min_dihedral_deg, "{rel}");
+    }
+}
+
+#[test]
+fn deterministic() {
+    let (a, _) = mesh("poly/tetgen_example.poly", true);
+    let (b, _) = mesh("poly/tetgen_example.poly", true);
+    assert_eq!(a, b);
+}
+
+/// The acute models: no degenerate tet, the surface kept, and the improvement helps.
+fn acute(rel: &str) {
+    let (m, r) = mesh(rel, true);
+    check_kept(rel, &m);
+    let (lo, _) = dihedral_range(&m);
+    assert!(
+        lo >= r.dihedral_before_improve_deg[0],
+        "{rel}: {lo} < before"
+    );
+    assert!(lo > 0.0);
+}
+
+#[test]
+fn acute_rotor() {
+    acute("off/rotor.off");
+}
+#[test]
+fn acute_part() {
+    acute("off/part.off");
+}
+#[test]
+fn acute_fandisk_joint() {
+    acute("off/fandisk.off");
+    acute("off/joint.off");
+}
+#[test]
+fn acute_others() {
+    for rel in [
+        "off/anchor.off",
+        "off/elephant.off",
+        "off/oblong.off",
+        "off/spool.off",
+        "off/star.off",
+    ] {
+        acute(rel);
+    }
+}
