@@ -33,7 +33,9 @@ if [[ -n "$fc" ]]; then
 fi
 
 # The shared build must load the installed library (through its SONAME link).
-if ! ldd "$work/c-shared/cube_c" | grep -q "$prefix/lib/libslivermesh.so"; then
+# (ldd's output is captured first: `ldd | grep -q` under pipefail fails when grep exits early.)
+loaded="$(ldd "$work/c-shared/cube_c")"
+if ! grep -q "$prefix/lib/libslivermesh.so" <<<"$loaded"; then
   echo "c-shared does not load $prefix/lib/libslivermesh.so:"
   ldd "$work/c-shared/cube_c"
   exit 1
