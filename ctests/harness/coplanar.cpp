@@ -26,17 +26,6 @@ struct Plane {
   bool contains(const Vec3& q) const { return CGAL::orientation(a, b, c, pt(q)) == CGAL::COPLANAR; }
 };
 
-Vec3 newell(const std::vector<Vec3>& v, const Polygon& p) {
-  Vec3 n{0, 0, 0};
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    const Vec3& a = v[p[i]];
-    const Vec3& b = v[p[(i + 1) % p.size()]];
-    n[0] += (a[1] - b[1]) * (a[2] + b[2]);
-    n[1] += (a[2] - b[2]) * (a[0] + b[0]);
-    n[2] += (a[0] - b[0]) * (a[1] + b[1]);
-  }
-  return n;
-}
 double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 // The plane of a mergeable facet: one polygon without holes, no repeated neighbours, planar,

@@ -14,6 +14,19 @@ namespace harness {
 using Vec3 = std::array<double, 3>;
 using Polygon = std::vector<uint32_t>;  // 0-based vertex ids in order around the polygon
 
+// Newell's normal of a polygon (twice its vector area).
+inline Vec3 newell(const std::vector<Vec3>& v, const Polygon& p) {
+  Vec3 n{0, 0, 0};
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const Vec3& a = v[p[i]];
+    const Vec3& b = v[p[(i + 1) % p.size()]];
+    n[0] += (a[1] - b[1]) * (a[2] + b[2]);
+    n[1] += (a[2] - b[2]) * (a[0] + b[0]);
+    n[2] += (a[0] - b[0]) * (a[1] + b[1]);
+  }
+  return n;
+}
+
 struct Facet {
   Polygon outer;
   std::vector<Polygon> holes;  // sm_add_facet_hole

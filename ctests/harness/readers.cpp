@@ -79,18 +79,6 @@ bool ends_with(const std::string& s, const std::string& tail) {
                     [](char a, char b) { return std::tolower(a) == std::tolower(b); });
 }
 
-// Newell's normal of a polygon (twice its vector area).
-Vec3 newell(const std::vector<Vec3>& v, const Polygon& p) {
-  Vec3 n{0, 0, 0};
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    const Vec3& a = v[p[i]];
-    const Vec3& b = v[p[(i + 1) % p.size()]];
-    n[0] += (a[1] - b[1]) * (a[2] + b[2]);
-    n[1] += (a[2] - b[2]) * (a[0] + b[0]);
-    n[2] += (a[0] - b[0]) * (a[1] + b[1]);
-  }
-  return n;
-}
 
 // Whether q lies inside polygon p, in the coordinate plane the polygon's normal is closest to.
 // Floating point: it only decides which polygon a facet hole point marks as a hole.

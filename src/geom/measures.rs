@@ -58,7 +58,7 @@ pub const DIHEDRAL_EDGES: [[usize; 2]; 6] = [[0, 1], [0, 2], [0, 3], [1, 2], [1,
 
 /// Squared edge lengths in [`DIHEDRAL_EDGES`] order, from u = b-a, v = c-a, w = d-a.
 #[inline(always)]
-fn edge_lengths_sq(u: DVec3, v: DVec3, w: DVec3) -> [f64; 6] {
+pub(crate) fn edge_lengths_sq(u: DVec3, v: DVec3, w: DVec3) -> [f64; 6] {
     [
         u.length_squared(),
         v.length_squared(),

@@ -26,14 +26,7 @@ pub fn min_sin(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
         v.cross(u).length(),
     ];
     let det = u.dot(v.cross(w));
-    let l2 = [
-        u.length_squared(),
-        v.length_squared(),
-        w.length_squared(),
-        (v - u).length_squared(),
-        (w - u).length_squared(),
-        (w - v).length_squared(),
-    ];
+    let l2 = crate::geom::measures::edge_lengths_sq(u, v, w);
     let mut m = f64::INFINITY;
     for (i, [k, l]) in EDGE_FACES.iter().copied().enumerate() {
         m = m.min(l2[i].sqrt() / (n[k] * n[l]));
