@@ -9,6 +9,7 @@
 #![deny(clippy::undocumented_unsafe_blocks)]
 
 pub mod api;
+pub mod approx;
 pub mod cdt;
 pub mod delaunay;
 pub mod ffi;
@@ -16,6 +17,7 @@ pub mod geom;
 pub mod improve;
 pub mod io;
 pub mod mesh;
+pub mod pipeline;
 pub mod plc;
 pub mod quality;
 pub mod refine;

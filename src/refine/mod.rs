@@ -54,7 +54,31 @@ pub struct Params {
     /// Improve the mesh after refinement (`crate::improve`: flips, edge removal, smoothing).
     /// False keeps the refinement's Delaunay mesh, with only flat or inverted tets removed.
     pub improve: bool,
+    /// What the input facets are: constraints kept exactly (`Keep`), or the description of a
+    /// piecewise smooth surface that the output approximates (`Approximate`, `crate::approx`).
+    pub surface_mode: SurfaceMode,
+    /// Approximate mode: an edge whose two triangles' normals differ by more than this many
+    /// degrees is a sharp feature. Default 40.
+    pub feature_angle: f64,
+    /// Approximate mode: how far the output boundary may lie from the input surface
+    /// (absolute length; 0 = the default, 0.001 x the input's bounding-box diagonal).
+    pub surface_distance: f64,
 }
+
+/// How the input facets bound the domain.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+pub enum SurfaceMode {
+    /// Every input facet is preserved exactly (TetGen-style input).
+    #[default]
+    Keep,
+    /// The facets describe a piecewise smooth surface: sharp features are kept, smooth
+    /// patches are remeshed within `surface_distance`.
+    Approximate,
+}
+
+/// Share of the bounding-box diagonal that is the default `surface_distance` (fTetWild's
+/// default envelope).
+pub const DEFAULT_SURFACE_DISTANCE_FRACTION: f64 = 1e-3;
 
 impl Default for Params {
     fn default() -> Self {
@@ -71,6 +95,9 @@ impl Default for Params {
             refine: true,
             small_angle_reach: f64::INFINITY,
             improve: true,
+            surface_mode: SurfaceMode::Keep,
+            feature_angle: 40.0,
+            surface_distance: 0.0,
         }
     }
 }
@@ -107,6 +134,22 @@ impl Params {
             return Err(format!(
                 "parameter min_dihedral = {} must be in [0, 70.5) degrees",
                 self.min_dihedral
+            ));
+        }
+        if !(self.feature_angle.is_finite()
+            && self.feature_angle > 0.0
+            && self.feature_angle < 180.0)
+        {
+            return Err(format!(
+                "parameter feature_angle = {} must be in (0, 180) degrees",
+                self.feature_angle
+            ));
+        }
+        if !(self.surface_distance.is_finite() && self.surface_distance >= 0.0) {
+            return Err(format!(
+                "parameter surface_distance = {} must be finite and >= 0 (0: the default, \
+                 0.001 x the bounding-box diagonal)",
+                self.surface_distance
             ));
         }
         if self.delta >= 1.0 {
@@ -209,6 +252,37 @@ pub struct Report {
     pub seconds_improvement: f64,
     /// What the improvement pass did.
     pub improvement: crate::improve::Stats,
+    /// Approximate surface mode only: how close the output boundary is to the input surface.
+    pub surface: Option<SurfaceReport>,
+}
+
+/// How well the output boundary approximates the input surface (approximate mode).
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
+pub struct SurfaceReport {
+    /// The distance bound the boundary was built to (absolute).
+    pub surface_distance: f64,
+    /// Sampled one-sided distances: every input point to the output boundary, and back.
+    pub hausdorff_input_to_output: f64,
+    pub hausdorff_output_to_input: f64,
+    /// The largest distance of a point of an input feature edge from the output's feature
+    /// edges.
+    pub feature_distance: f64,
+    /// (output volume - input volume) / input volume.
+    pub relative_volume_difference: f64,
+    /// Sharp edges, feature polylines, corners and smooth patches found in the input.
+    pub n_feature_edges: usize,
+    pub n_feature_polylines: usize,
+    pub n_corners: usize,
+    pub n_patches: usize,
+    /// Feature corners whose angle (between feature curves, or spanned by a patch) is below
+    /// 60 degrees, and the output tets within their influence that miss a bound.
+    pub n_small_corners: usize,
+    pub n_bad_near_small_corners: usize,
+    /// Vertices and triangles of the remeshed boundary.
+    pub n_surface_vertices: usize,
+    pub n_surface_triangles: usize,
+    /// Time spent building the boundary (feature protection and restricted Delaunay facets).
+    pub seconds_surface: f64,
 }
 
 /// Why meshing failed.
@@ -310,6 +384,18 @@ pub fn mesh(
     progress: Option<Progress>,
 ) -> Result<(TetMesh, Report), MeshError> {
     mesh_domain(input, params, spacing, progress, true, Unseeded::Domain)
+}
+
+/// [`mesh`] of a boundary the approximate mode built (`crate::approx`): its triangles meet at
+/// angles that are a remeshing's, not the input's, so only the angles at `small_angle_vertices`
+/// (the input's real small corners) are respected.
+pub(crate) fn mesh_remeshed(
+    input: &PlcInput,
+    params: &Params,
+    spacing: Option<&dyn Spacing>,
+    progress: Option<Progress>,
+) -> Result<(TetMesh, Report), MeshError> {
+    mesh_domain(input, params, spacing, progress, false, Unseeded::Domain)
 }
 
 /// [`mesh`], optionally treating every input angle as large (for the boundary of an existing
