@@ -28,12 +28,18 @@ impl Hausdorff {
 
 /// Sample points of every triangle of `s`, at most `spacing` apart along each edge direction.
 pub fn samples(s: &InputSurface, spacing: f64) -> Vec<DVec3> {
+    samples_per_edge_at_least(s, spacing, 1)
+}
+
+/// [`samples`], with every triangle's edges cut into at least `min_pieces` (small triangles
+/// still get interior samples, where a curved surface is farthest from them).
+pub fn samples_per_edge_at_least(s: &InputSurface, spacing: f64, min_pieces: usize) -> Vec<DVec3> {
     assert!(spacing > 0.0, "sampling spacing must be positive");
     let mut out = Vec::new();
     for t in 0..s.triangles.len() {
         let [a, b, c] = s.corners(t);
         let longest = (b - a).length().max((c - b).length()).max((a - c).length());
-        let k = ((longest / spacing).ceil() as usize).clamp(1, 4096);
+        let k = ((longest / spacing).ceil() as usize).clamp(min_pieces.max(1), 4096);
         for i in 0..=k {
             for j in 0..=(k - i) {
                 let (u, v) = (i as f64 / k as f64, j as f64 / k as f64);

@@ -1,0 +1,117 @@
+//! The report's surface figures, measured on the output mesh: two-sided sampled Hausdorff
+//! distance between its boundary and the input surface, how far input feature edges are from
+//! the output's feature edges, the volume difference, and the bad tets near small corners.
+
+use super::curves::point_segment_distance;
+use super::Remeshed;
+use crate::geom::{min_max_dihedral, radius_edge_ratio, volume};
+use crate::mesh::TetMesh;
+use crate::refine::{Params, SurfaceReport};
+use crate::surface::distance::samples_per_edge_at_least;
+use crate::surface::oracle::SurfaceOracle;
+use crate::surface::InputSurface;
+use glam::DVec3;
+
+/// Sample spacing of the Hausdorff distance as a share of the bounding-box diagonal (samples
+/// as close as the distance bound would cost millions of closest-point queries); every
+/// triangle is also cut into at least [`MIN_PIECES`] along each edge, so each output triangle
+/// is sampled inside, where it is farthest from a curved input.
+const HAUSDORFF_SPACING: f64 = 1.0 / 400.0;
+const MIN_PIECES: usize = 3;
+
+/// Largest distance from samples of `from` to `to`.
+fn one_sided(from: &InputSurface, to: &InputSurface, spacing: f64) -> f64 {
+    let oracle = SurfaceOracle::new(to);
+    samples_per_edge_at_least(from, spacing, MIN_PIECES)
+        .into_iter()
+        .filter_map(|p| oracle.closest(p))
+        .map(|c| c.distance)
+        .fold(0.0, f64::max)
+}
+
+/// Points per input feature edge where its distance to the output's feature edges is taken.
+const FEATURE_EDGE_SAMPLES: usize = 8;
+
+pub fn surface_report(r: &Remeshed, mesh: &TetMesh) -> SurfaceReport {
+    let out = InputSurface::from_triangles(mesh.vertices.clone(), mesh.boundary.clone());
+    let spacing = HAUSDORFF_SPACING * r.surface.bbox_diagonal();
+    let out_volume: f64 = mesh
+        .tets
+        .iter()
+        .map(|t| {
+            let [a, b, c, d] = t.map(|v| mesh.vertices[v as usize]);
+            volume(a, b, c, d)
+        })
+        .sum();
+    SurfaceReport {
+        surface_distance: r.distance,
+        hausdorff_input_to_output: one_sided(&r.surface, &out, spacing),
+        hausdorff_output_to_input: one_sided(&out, &r.surface, spacing),
+        feature_distance: feature_distance(r),
+        relative_volume_difference: if r.input_volume > 0.0 {
+            (out_volume - r.input_volume) / r.input_volume
+        } else {
+            0.0
+        },
+        n_feature_edges: r.features.edges.len(),
+        n_feature_polylines: r.features.polylines.len(),
+        n_corners: r.n_corners,
+        n_patches: r.features.n_patches,
+        n_small_corners: r.small_corners.len(),
+        n_bad_near_small_corners: 0,
+        n_surface_vertices: r.boundary.vertices.len(),
+        n_surface_triangles: r.boundary.facets.len(),
+        seconds_surface: r.seconds,
+    }
+}
+
+/// Largest distance from a sample of an input feature edge to the nearest output feature edge
+/// (brute force over the output's feature edges, which number a few thousand).
+fn feature_distance(r: &Remeshed) -> f64 {
+    let segs: Vec<(DVec3, DVec3)> = r
+        .feature_edges
+        .iter()
+        .map(|e| e.map(|v| r.boundary.vertices[v as usize]))
+        .map(|[a, b]| (a, b))
+        .collect();
+    let mut worst: f64 = 0.0;
+    for e in &r.features.edges {
+        let [a, b] = e.map(|v| r.surface.vertices[v as usize]);
+        for k in 0..=FEATURE_EDGE_SAMPLES {
+            let p = a.lerp(b, k as f64 / FEATURE_EDGE_SAMPLES as f64);
+            let d = segs
+                .iter()
+                .map(|&(u, v)| point_segment_distance(p, u, v))
+                .fold(f64::INFINITY, f64::min);
+            worst = worst.max(d);
+        }
+    }
+    if segs.is_empty() && !r.features.edges.is_empty() {
+        return f64::INFINITY;
+    }
+    worst
+}
+
+/// Tets with a vertex within twice the protecting radius of a small corner whose radius-edge
+/// ratio or smallest dihedral angle misses the refinement's bound.
+pub fn bad_near_corners(mesh: &TetMesh, corners: &[(DVec3, f64)], params: &Params) -> usize {
+    if corners.is_empty() {
+        return 0;
+    }
+    mesh.tets
+        .iter()
+        .filter(|t| {
+            let p = t.map(|v| mesh.vertices[v as usize]);
+            let near = p.iter().any(|q| {
+                corners
+                    .iter()
+                    .any(|(c, r)| (*q - *c).length_squared() < 4.0 * r * r)
+            });
+            if !near {
+                return false;
+            }
+            let (lo, _) = min_max_dihedral(p[0], p[1], p[2], p[3]);
+            lo < params.min_dihedral || radius_edge_ratio(p[0], p[1], p[2], p[3]) > params.rho0
+        })
+        .count()
+}

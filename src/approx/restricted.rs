@@ -1,0 +1,796 @@
+//! The restricted Delaunay surface mesher: samples of the input surface in a 3D Delaunay
+//! triangulation, refined until every restricted facet (a Delaunay face whose dual Voronoi
+//! edge crosses the surface) is good, then the faces between tets whose circumcentres lie
+//! inside and outside the domain are the new boundary.
+//!
+//! Feature curves are protected without weights (the unweighted equivalent of CGAL's
+//! protecting balls): each curve is cut into subsegments that must stay Delaunay edges with
+//! an empty diametric ball. A surface centre that would land in a subsegment's ball splits the
+//! subsegment instead (Shewchuk's encroachment rule, at concentric shells next to corners
+//! as in Ruppert's algorithm, so splits cannot cascade towards a corner), and a subsegment is
+//! also split while it is longer than f or its chord leaves the curve by more than the
+//! distance bound. Next to a small corner (below 60 degrees) nothing is split for being
+//! encroached and no facet is refined for its angle: that is where the report says quality is
+//! not enforced.
+//!
+//! A restricted facet is bad (CGAL Mesh_3's facet criteria) when a vertex is not on the patch
+//! its surface centre lies on nor on a curve or corner of that patch, when its surface ball is
+//! larger than f, when its smallest angle is below `min_angle_deg`, or when its circumcentre is
+//! farther than the distance bound from its surface centre. Bad facets are refined largest
+//! first, each at its surface centre.
+
+use super::curves::{Curve, FeatureCurves};
+use crate::delaunay::tables::FACE;
+use crate::delaunay::{Delaunay, Inserted, INFINITE};
+use crate::geom::{circumcenter, tri_circumcenter};
+use crate::refine::{MeshError, Spacing};
+use crate::surface::oracle::{Side, SurfaceOracle};
+use crate::surface::InputSurface;
+use glam::DVec3;
+use rustc_hash::{FxHashMap, FxHashSet};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+/// What the surface mesher aims for.
+#[derive(Debug, Clone, Copy)]
+pub struct SurfaceCriteria {
+    /// Largest distance between a facet's circumcentre and its surface centre, and between a
+    /// subsegment's chord and its curve.
+    pub distance: f64,
+    /// Smallest facet angle, degrees (CGAL's facet_angle; 30 is the guaranteed-terminating
+    /// bound of Boissonnat & Oudot).
+    pub min_angle_deg: f64,
+    /// Stop (with a reason) past this many vertices.
+    pub max_vertices: usize,
+    /// Seed of the random surface samples.
+    pub seed: u64,
+}
+
+/// Where a vertex of the surface triangulation lies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Loc {
+    /// A corner of the bounding box around everything (never part of the output).
+    Far,
+    Corner(u32),
+    Curve(u32),
+    Patch(u32),
+}
+
+/// A piece of a feature curve between two consecutive vertices on it.
+#[derive(Debug, Clone, Copy)]
+struct SubSeg {
+    curve: u32,
+    /// Arc lengths of its ends (`ends` of the key in curve order).
+    s: [f64; 2],
+    /// Vertices in curve order.
+    ends: [u32; 2],
+}
+
+/// A face of the triangulation whose Voronoi edge crosses the surface.
+#[derive(Debug, Clone, Copy)]
+struct Restricted {
+    vertices: [u32; 3],
+    centre: DVec3,
+    radius: f64,
+    triangle: u32,
+}
+
+/// A bad facet waiting in the queue: larger surface balls first, ties by vertices.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Queued {
+    radius: f64,
+    face: [u32; 3],
+}
+impl Eq for Queued {}
+impl PartialOrd for Queued {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Queued {
+    fn cmp(&self, other: &Self) -> Ordering {
+        self.radius
+            .total_cmp(&other.radius)
+            .then_with(|| other.face.cmp(&self.face))
+    }
+}
+
+/// The new boundary: triangles oriented outwards, each with the input triangle its surface
+/// centre lies on.
+#[derive(Debug, Clone, Default)]
+pub struct Boundary {
+    pub points: Vec<DVec3>,
+    pub loc: Vec<Loc>,
+    pub triangles: Vec<[u32; 3]>,
+    pub input_triangle: Vec<u32>,
+    /// Subsegments present in the boundary (feature edges of the output), as vertex pairs.
+    pub feature_edges: Vec<[u32; 2]>,
+    /// Why the mesher stopped before every facet was good, if it did.
+    pub stop_reason: Option<String>,
+    /// Facets left bad because refining them would enter a small corner's protecting ball.
+    pub n_blocked: usize,
+}
+
+pub struct SurfaceMesher<'a> {
+    surface: &'a InputSurface,
+    oracle: &'a SurfaceOracle<'a>,
+    curves: &'a FeatureCurves,
+    patch_of: &'a [u32],
+    spacing: &'a dyn Spacing,
+    criteria: SurfaceCriteria,
+    dt: Delaunay,
+    loc: Vec<Loc>,
+    subsegs: FxHashMap<[u32; 2], SubSeg>,
+    seg_queue: Vec<[u32; 2]>,
+    force_split: FxHashSet<[u32; 2]>,
+    facets: BinaryHeap<Queued>,
+    /// Subsegments too short to split further (their ends would coincide in floating point).
+    frozen: FxHashSet<[u32; 2]>,
+    n_blocked: usize,
+    bad_spacing: Option<MeshError>,
+    min_length: f64,
+}
+
+fn key2(a: u32, b: u32) -> [u32; 2] {
+    [a.min(b), a.max(b)]
+}
+
+fn key3(mut f: [u32; 3]) -> [u32; 3] {
+    f.sort_unstable();
+    f
+}
+
+/// Smallest angle of triangle (a, b, c), degrees.
+fn min_angle_deg(a: DVec3, b: DVec3, c: DVec3) -> f64 {
+    let angle = |p: DVec3, q: DVec3, r: DVec3| {
+        let (u, v) = (q - p, r - p);
+        u.cross(v).length().atan2(u.dot(v)).to_degrees()
+    };
+    angle(a, b, c).min(angle(b, c, a)).min(angle(c, a, b))
+}
+
+impl<'a> SurfaceMesher<'a> {
+    /// Samples the corners, curves and patches and triangulates the samples.
+    pub fn new(
+        surface: &'a InputSurface,
+        oracle: &'a SurfaceOracle<'a>,
+        curves: &'a FeatureCurves,
+        patch_of: &'a [u32],
+        spacing: &'a dyn Spacing,
+        criteria: SurfaceCriteria,
+    ) -> Result<SurfaceMesher<'a>, MeshError> {
+        let diagonal = surface.bbox_diagonal();
+        let mut m = SurfaceMesher {
+            surface,
+            oracle,
+            curves,
+            patch_of,
+            spacing,
+            criteria,
+            dt: Delaunay::default(),
+            loc: vec![],
+            subsegs: FxHashMap::default(),
+            seg_queue: vec![],
+            force_split: FxHashSet::default(),
+            facets: BinaryHeap::new(),
+            frozen: FxHashSet::default(),
+            n_blocked: 0,
+            bad_spacing: None,
+            min_length: 1e-9 * diagonal,
+        };
+        let mut points = far_box(surface, diagonal);
+        m.loc = vec![Loc::Far; points.len()];
+        let mut grid = SampleGrid::new(m.typical_spacing(), surface);
+        for (k, c) in curves.corners.iter().enumerate() {
+            points.push(c.point);
+            m.loc.push(Loc::Corner(k as u32));
+            grid.add(c.point);
+        }
+        for (ci, curve) in curves.curves.iter().enumerate() {
+            m.sample_curve(ci as u32, curve, &mut points, &mut grid);
+        }
+        m.sample_patches(&mut points, &mut grid, criteria.seed);
+        if let Some(e) = m.bad_spacing.take() {
+            return Err(e);
+        }
+        let (dt, _) = Delaunay::from_points(&points)
+            .map_err(|e| MeshError::InvalidInput(format!("surface samples: {e}")))?;
+        m.dt = dt;
+        m.seg_queue = {
+            let mut keys: Vec<[u32; 2]> = m.subsegs.keys().copied().collect();
+            keys.sort_unstable();
+            keys.reverse();
+            keys
+        };
+        let tets: Vec<u32> = m.dt.finite_tet_ids().collect();
+        for t in tets {
+            for i in 0..4 {
+                m.queue_face(t, i);
+            }
+        }
+        Ok(m)
+    }
+
+    fn f(&mut self, p: DVec3) -> f64 {
+        let v = self.spacing.at(p);
+        if !(v.is_finite() && v > 0.0) {
+            self.bad_spacing.get_or_insert(MeshError::BadSpacing { point: p, value: v });
+            return f64::INFINITY;
+        }
+        v
+    }
+
+    /// The spacing at the surface's vertices, median (the sample grid's cell size).
+    fn typical_spacing(&mut self) -> f64 {
+        let step = (self.surface.vertices.len() / 64).max(1);
+        let pts: Vec<DVec3> = self.surface.vertices.iter().step_by(step).copied().collect();
+        let mut v: Vec<f64> = pts.into_iter().map(|p| self.f(p)).collect();
+        v.sort_by(f64::total_cmp);
+        v.get(v.len() / 2).copied().unwrap_or(1.0)
+    }
+
+    /// Points along a curve, at most f apart (at least two pieces, three on a closed curve,
+    /// so that no two subsegments share both ends).
+    fn sample_curve(
+        &mut self,
+        ci: u32,
+        curve: &Curve,
+        points: &mut Vec<DVec3>,
+        grid: &mut SampleGrid,
+    ) {
+        let len = curve.length();
+        let mut params = vec![0.0];
+        let mut s = 0.0;
+        loop {
+            let step = self.f(curve.point_at(s)).min(len);
+            if s + step >= len - 0.3 * step {
+                break;
+            }
+            s += step;
+            params.push(s);
+        }
+        let min_pieces = if curve.closed { 3 } else { 2 };
+        if params.len() < min_pieces {
+            params = (0..min_pieces)
+                .map(|k| len * k as f64 / min_pieces as f64)
+                .collect();
+        }
+        params.push(len);
+        let corner = |v: u32| self.curves.corner_of[&v] + 8;
+        let mut ids = vec![corner(curve.ends[0])];
+        for &s in &params[1..params.len() - 1] {
+            let p = curve.point_at(s);
+            ids.push(points.len() as u32);
+            points.push(p);
+            self.loc.push(Loc::Curve(ci));
+            grid.add(p);
+        }
+        ids.push(corner(curve.ends[1]));
+        for k in 0..ids.len() - 1 {
+            self.subsegs.insert(
+                key2(ids[k], ids[k + 1]),
+                SubSeg {
+                    curve: ci,
+                    s: [params[k], params[k + 1]],
+                    ends: [ids[k], ids[k + 1]],
+                },
+            );
+        }
+    }
+
+    /// Poisson-disk samples of every triangle's interior: random points (regular lattices
+    /// would put four samples on one circle everywhere on a planar patch, and the Delaunay
+    /// triangulation would be full of flat tets), greedy, at least 0.7 f from every accepted
+    /// sample and curve point.
+    fn sample_patches(&mut self, points: &mut Vec<DVec3>, grid: &mut SampleGrid, seed: u64) {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        for t in 0..self.surface.triangles.len() {
+            let [a, b, c] = self.surface.corners(t);
+            let area = 0.5 * (b - a).cross(c - a).length();
+            let h = self.f((a + b + c) / 3.0);
+            let tries = ((4.0 * area / (h * h)).ceil() as usize).clamp(1, 1 << 16);
+            for _ in 0..tries {
+                let (mut u, mut v): (f64, f64) = (rng.gen(), rng.gen());
+                if u + v > 1.0 {
+                    (u, v) = (1.0 - u, 1.0 - v);
+                }
+                let p = a + (b - a) * u + (c - a) * v;
+                let r = 0.7 * self.f(p);
+                if grid.has_within(p, r) {
+                    continue;
+                }
+                grid.add(p);
+                points.push(p);
+                self.loc.push(Loc::Patch(self.patch_of[t]));
+            }
+        }
+    }
+
+    /// Refines until every restricted facet is good (or a budget or small corner stops it),
+    /// then extracts the boundary; repeats while the boundary is not a closed 2-manifold of
+    /// surface vertices.
+    pub fn run(mut self) -> Result<Boundary, MeshError> {
+        let mut stop_reason = None;
+        for _round in 0..16 {
+            stop_reason = self.refine();
+            if let Some(e) = self.bad_spacing.take() {
+                return Err(e);
+            }
+            if stop_reason.is_some() {
+                break;
+            }
+            let (faces, problems) = self.extract();
+            if problems.is_empty() {
+                return Ok(self.boundary(faces, None));
+            }
+            for (t, i) in problems {
+                if let Some(r) = self.facet_at(t, i) {
+                    self.insert_surface_point(r, t);
+                }
+            }
+        }
+        let (faces, problems) = self.extract();
+        if problems.is_empty() {
+            return Ok(self.boundary(faces, stop_reason));
+        }
+        Err(MeshError::InvalidInput(format!(
+            "surface mode approximate: the remeshed boundary is not a closed manifold \
+             ({} faces in the way{}); try a smaller spacing or --surface keep",
+            problems.len(),
+            stop_reason.map(|r| format!("; {r}")).unwrap_or_default()
+        )))
+    }
+
+    /// The refinement loop: subsegments first, then the largest bad facet.
+    fn refine(&mut self) -> Option<String> {
+        let debug = std::env::var("SM_DEBUG").is_ok();
+        let mut steps = 0usize;
+        loop {
+            steps += 1;
+            if debug && steps % 1000 == 0 {
+                eprintln!(
+                    "step {steps}: {} vertices, {} subsegs, seg queue {}, facet queue {}, blocked {}",
+                    self.dt.num_vertices(),
+                    self.subsegs.len(),
+                    self.seg_queue.len(),
+                    self.facets.len(),
+                    self.n_blocked
+                );
+            }
+            if self.dt.num_vertices() > self.criteria.max_vertices {
+                return Some(format!(
+                    "the surface mesh reached {} vertices (max_vertices)",
+                    self.criteria.max_vertices
+                ));
+            }
+            if self.bad_spacing.is_some() {
+                return None;
+            }
+            if let Some(k) = self.seg_queue.pop() {
+                self.check_subseg(k);
+                continue;
+            }
+            let Some(q) = self.facets.pop() else {
+                return None;
+            };
+            self.refine_facet(q.face);
+        }
+    }
+
+    fn near_small_corner(&self, p: DVec3) -> bool {
+        self.curves
+            .small_corners()
+            .any(|c| (p - c.point).length_squared() < c.protect_radius * c.protect_radius)
+    }
+
+    fn check_subseg(&mut self, k: [u32; 2]) {
+        let Some(ss) = self.subsegs.get(&k).copied() else {
+            return;
+        };
+        if self.frozen.contains(&k) {
+            return;
+        }
+        let forced = self.force_split.remove(&k);
+        let [a, b] = ss.ends.map(|v| self.dt.point(v));
+        let curve = &self.curves.curves[ss.curve as usize];
+        let split = forced
+            || self.dt.find_edge(k[0], k[1]).is_none()
+            || (!self.near_small_corner((a + b) / 2.0)
+                && ((a - b).length() > self.f((a + b) / 2.0)
+                    || curve.chord_deviation(ss.s[0], ss.s[1]) > self.criteria.distance
+                    || self.encroached(k, a, b)));
+        if split {
+            self.split_subseg(k, ss);
+        }
+    }
+
+    /// Whether a vertex next to edge k lies inside its diametric ball.
+    fn encroached(&self, k: [u32; 2], a: DVec3, b: DVec3) -> bool {
+        let (m, r2) = ((a + b) / 2.0, (a - b).length_squared() / 4.0);
+        self.dt.vertex_star(k[0]).into_iter().any(|t| {
+            let tv = self.dt.tet(t);
+            tv.contains(&k[1])
+                && tv.iter().any(|&w| {
+                    w != INFINITE
+                        && w != k[0]
+                        && w != k[1]
+                        && (self.dt.point(w) - m).length_squared() < r2
+                })
+        })
+    }
+
+    /// Splits at the middle, or next to a corner at a power-of-two distance from it
+    /// (concentric shells: two curves leaving a corner are split at the same distances).
+    fn split_subseg(&mut self, k: [u32; 2], ss: SubSeg) {
+        let len = ss.s[1] - ss.s[0];
+        let curve = &self.curves.curves[ss.curve as usize];
+        if (self.dt.point(k[0]) - self.dt.point(k[1])).length() < self.min_length {
+            self.frozen.insert(k);
+            return;
+        }
+        let is_corner = |v: u32| matches!(self.loc[v as usize], Loc::Corner(_));
+        let shell = |d: f64| 2f64.powf((d / 2.0).log2().round()).clamp(0.25 * d, 0.75 * d);
+        let s = match (is_corner(ss.ends[0]), is_corner(ss.ends[1])) {
+            (true, false) => ss.s[0] + shell(len),
+            (false, true) => ss.s[1] - shell(len),
+            _ => ss.s[0] + 0.5 * len,
+        };
+        let p = curve.point_at(s);
+        let hint = self.dt.vertex_tet(k[0]);
+        let id = match self.dt.insert(p, hint) {
+            Ok(Inserted::New(id)) => id,
+            _ => {
+                self.frozen.insert(k);
+                return;
+            }
+        };
+        self.loc.push(Loc::Curve(ss.curve));
+        debug_assert_eq!(self.loc.len(), id as usize + 1);
+        self.subsegs.remove(&k);
+        for (e, sp) in [
+            ([ss.ends[0], id], [ss.s[0], s]),
+            ([id, ss.ends[1]], [s, ss.s[1]]),
+        ] {
+            self.subsegs.insert(
+                key2(e[0], e[1]),
+                SubSeg {
+                    curve: ss.curve,
+                    s: sp,
+                    ends: e,
+                },
+            );
+            self.seg_queue.push(key2(e[0], e[1]));
+        }
+        self.after_insertion();
+    }
+
+    /// Queues what an insertion may have made bad: subsegments among the removed and created
+    /// tets' edges, and the faces of the created tets.
+    fn after_insertion(&mut self) {
+        let created = self.dt.last_created().to_vec();
+        let mut quads = self.dt.last_removed().to_vec();
+        quads.extend(created.iter().map(|&t| self.dt.tet(t)));
+        let mut seen = FxHashSet::default();
+        for tv in &quads {
+            for i in 0..4 {
+                for j in i + 1..4 {
+                    let k = key2(tv[i], tv[j]);
+                    if self.subsegs.contains_key(&k) && seen.insert(k) {
+                        self.seg_queue.push(k);
+                    }
+                }
+            }
+        }
+        for t in created {
+            for i in 0..4 {
+                self.queue_face(t, i);
+            }
+        }
+    }
+
+    fn queue_face(&mut self, t: u32, i: usize) {
+        if let Some(r) = self.facet_at(t, i) {
+            if self.is_bad(&r) {
+                self.facets.push(Queued {
+                    radius: r.radius,
+                    face: key3(r.vertices),
+                });
+            }
+        }
+    }
+
+    /// Face `i` of tet `t` if its Voronoi edge crosses the surface, with the crossing farthest
+    /// from its vertices as surface centre.
+    fn facet_at(&self, t: u32, i: usize) -> Option<Restricted> {
+        let tv = self.dt.tet(t);
+        let n = self.dt.neighbors(t)[i];
+        let nv = self.dt.tet(n);
+        if tv.contains(&INFINITE) || nv.contains(&INFINITE) {
+            return None;
+        }
+        let c1 = circumcenter_of(&self.dt, tv)?;
+        let c2 = circumcenter_of(&self.dt, nv)?;
+        let face = FACE[i].map(|k| tv[k]);
+        let a = self.dt.point(face[0]);
+        let best = self
+            .oracle
+            .crossings(c1, c2)
+            .into_iter()
+            .map(|x| ((x.point - a).length(), x))
+            .max_by(|x, y| x.0.total_cmp(&y.0))?;
+        Some(Restricted {
+            vertices: face,
+            centre: best.1.point,
+            radius: best.0,
+            triangle: best.1.triangle,
+        })
+    }
+
+    fn on_patch(&self, v: u32, patch: u32) -> bool {
+        match self.loc[v as usize] {
+            Loc::Far => false,
+            Loc::Patch(p) => p == patch,
+            Loc::Curve(c) => self.curves.curves[c as usize].patches.contains(&patch),
+            Loc::Corner(k) => self.curves.corners[k as usize].patches.contains(&patch),
+        }
+    }
+
+    fn is_bad(&mut self, r: &Restricted) -> bool {
+        self.badness(r) != 0
+    }
+
+    /// 0 good, 1 topology, 2 size, 3 angle, 4 distance.
+    fn badness(&mut self, r: &Restricted) -> u8 {
+        let patch = self.patch_of[r.triangle as usize];
+        if !r.vertices.iter().all(|&v| self.on_patch(v, patch)) {
+            return 1;
+        }
+        if r.radius > self.f(r.centre) {
+            return 2;
+        }
+        let [a, b, c] = r.vertices.map(|v| self.dt.point(v));
+        let protected = [a, b, c].iter().any(|&p| self.near_small_corner(p));
+        if !protected && min_angle_deg(a, b, c) < self.criteria.min_angle_deg {
+            return 3;
+        }
+        if tri_circumcenter(a, b, c).is_some_and(|cc| (cc - r.centre).length() > self.criteria.distance) {
+            return 4;
+        }
+        0
+    }
+
+    fn refine_facet(&mut self, face: [u32; 3]) {
+        let Some([(t, i), _]) = self.dt.find_face(face[0], face[1], face[2]) else {
+            return;
+        };
+        let Some(r) = self.facet_at(t, i) else {
+            return;
+        };
+        let why = self.badness(&r);
+        if why != 0 {
+            if std::env::var("SM_DEBUG").is_ok() && self.dt.num_vertices() % 97 == 0 {
+                let pts = r.vertices.map(|v| self.dt.point(v));
+                let near = (0..self.dt.num_vertex_ids() as u32).filter(|&v| self.dt.has_vertex(v)).map(|v| (self.dt.point(v) - r.centre).length()).fold(f64::INFINITY, f64::min);
+                let tv = self.dt.tet(t); let nv = self.dt.tet(self.dt.neighbors(t)[i]);
+                eprintln!("nearest {near} tets {:?} {:?} cc {:?} {:?}", tv, nv, circumcenter_of(&self.dt, tv), circumcenter_of(&self.dt, nv));
+                eprintln!("why {why} radius {} centre {:?} verts {:?} locs {:?} pts {:?}", r.radius, r.centre, r.vertices, r.vertices.map(|v| self.loc[v as usize]), pts);
+            }
+            self.insert_surface_point(r, t);
+        }
+    }
+
+    /// Inserts a facet's surface centre, or queues the subsegments it would encroach.
+    fn insert_surface_point(&mut self, r: Restricted, hint: u32) {
+        if self.near_small_corner(r.centre) {
+            self.n_blocked += 1;
+            return;
+        }
+        if let crate::delaunay::Probe::Duplicate(_) = self.dt.probe(r.centre, Some(hint)) {
+            self.n_blocked += 1;
+            return;
+        }
+        let encroached = self.encroached_by_probe(r.centre);
+        if !encroached.is_empty() {
+            for k in encroached {
+                self.force_split.insert(k);
+                self.seg_queue.push(k);
+            }
+            self.facets.push(Queued {
+                radius: r.radius,
+                face: key3(r.vertices),
+            });
+            return;
+        }
+        let Ok(Inserted::New(id)) = self.dt.insert(r.centre, Some(hint)) else {
+            self.n_blocked += 1;
+            return;
+        };
+        self.loc.push(Loc::Patch(self.patch_of[r.triangle as usize]));
+        debug_assert_eq!(self.loc.len(), id as usize + 1);
+        self.after_insertion();
+    }
+
+    /// Subsegments (splittable, outside small corners' balls) among the probed cavity's edges
+    /// whose diametric ball holds `p`.
+    fn encroached_by_probe(&self, p: DVec3) -> Vec<[u32; 2]> {
+        let (cavity, _) = self.dt.probed_cavity();
+        let mut out = vec![];
+        for &t in cavity {
+            let tv = self.dt.tet(t);
+            for i in 0..4 {
+                for j in i + 1..4 {
+                    let k = key2(tv[i], tv[j]);
+                    if out.contains(&k) || self.frozen.contains(&k) {
+                        continue;
+                    }
+                    if !self.subsegs.contains_key(&k) {
+                        continue;
+                    }
+                    let (a, b) = (self.dt.point(k[0]), self.dt.point(k[1]));
+                    let m = (a + b) / 2.0;
+                    if !self.near_small_corner(m)
+                        && (p - m).length_squared() < (a - b).length_squared() / 4.0
+                    {
+                        out.push(k);
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// The faces between tets whose circumcentres are inside and outside the surface (as
+    /// (inside tet, face index)), and those of them that break the boundary: a vertex off the
+    /// surface, or an edge not shared by exactly two faces.
+    fn extract(&self) -> (Vec<(u32, usize)>, Vec<(u32, usize)>) {
+        let cap = self.dt.tet_capacity();
+        let mut inside = vec![false; cap];
+        for t in self.dt.finite_tet_ids() {
+            if let Some(c) = circumcenter_of(&self.dt, self.dt.tet(t)) {
+                inside[t as usize] = self.oracle.side(c) != Side::Outside;
+            }
+        }
+        let mut faces = vec![];
+        for t in self.dt.finite_tet_ids() {
+            if !inside[t as usize] {
+                continue;
+            }
+            for (i, n) in self.dt.neighbors(t).iter().enumerate() {
+                if !inside[*n as usize] {
+                    faces.push((t, i));
+                }
+            }
+        }
+        let mut edge_count: FxHashMap<[u32; 2], u32> = FxHashMap::default();
+        for &(t, i) in &faces {
+            let tv = self.dt.tet(t);
+            let f = FACE[i].map(|k| tv[k]);
+            for j in 0..3 {
+                *edge_count.entry(key2(f[j], f[(j + 1) % 3])).or_default() += 1;
+            }
+        }
+        let problems = faces
+            .iter()
+            .copied()
+            .filter(|&(t, i)| {
+                let tv = self.dt.tet(t);
+                let f = FACE[i].map(|k| tv[k]);
+                f.iter().any(|&v| v == INFINITE || self.loc[v as usize] == Loc::Far)
+                    || (0..3).any(|j| edge_count[&key2(f[j], f[(j + 1) % 3])] != 2)
+            })
+            .collect();
+        (faces, problems)
+    }
+
+    /// The boundary from the extracted faces, oriented outwards, vertices renumbered.
+    fn boundary(&self, faces: Vec<(u32, usize)>, stop_reason: Option<String>) -> Boundary {
+        let mut out = Boundary {
+            stop_reason,
+            n_blocked: self.n_blocked,
+            ..Boundary::default()
+        };
+        let mut new_id: FxHashMap<u32, u32> = FxHashMap::default();
+        for (t, i) in faces {
+            let tv = self.dt.tet(t);
+            // FACE[i] turns its normal into tet t (inside): reversed, it points outwards.
+            let f = FACE[i].map(|k| tv[k]);
+            let tri = [f[0], f[2], f[1]].map(|v| {
+                *new_id.entry(v).or_insert_with(|| {
+                    out.points.push(self.dt.point(v));
+                    out.loc.push(self.loc[v as usize]);
+                    (out.points.len() - 1) as u32
+                })
+            });
+            let triangle = self.facet_at(t, i).map_or_else(
+                || self.oracle.closest(centroid(&self.dt, f)).map_or(0, |c| c.triangle),
+                |r| r.triangle,
+            );
+            out.triangles.push(tri);
+            out.input_triangle.push(triangle);
+        }
+        let mut edges: Vec<[u32; 2]> = self
+            .subsegs
+            .keys()
+            .filter_map(|k| Some(key2(*new_id.get(&k[0])?, *new_id.get(&k[1])?)))
+            .collect();
+        edges.sort_unstable();
+        out.feature_edges = edges;
+        out
+    }
+}
+
+fn centroid(dt: &Delaunay, f: [u32; 3]) -> DVec3 {
+    f.iter().map(|&v| dt.point(v)).sum::<DVec3>() / 3.0
+}
+
+fn circumcenter_of(dt: &Delaunay, tv: [u32; 4]) -> Option<DVec3> {
+    let [a, b, c, d] = tv.map(|v| dt.point(v));
+    circumcenter(a, b, c, d)
+}
+
+/// Eight points far around the surface, so that every face near it has two finite tets.
+fn far_box(s: &InputSurface, diagonal: f64) -> Vec<DVec3> {
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    for p in &s.vertices {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    let pad = DVec3::splat(diagonal.max(1e-300));
+    let (lo, hi) = (lo - pad, hi + pad);
+    (0..8)
+        .map(|k| {
+            DVec3::new(
+                if k & 1 == 0 { lo.x } else { hi.x },
+                if k & 2 == 0 { lo.y } else { hi.y },
+                if k & 4 == 0 { lo.z } else { hi.z },
+            )
+        })
+        .collect()
+}
+
+/// A uniform hash grid of accepted samples (Poisson-disk rejection).
+struct SampleGrid {
+    cell: f64,
+    origin: DVec3,
+    cells: FxHashMap<[i64; 3], Vec<DVec3>>,
+}
+
+impl SampleGrid {
+    fn new(cell: f64, s: &InputSurface) -> SampleGrid {
+        let origin = s.vertices.first().copied().unwrap_or(DVec3::ZERO);
+        SampleGrid {
+            cell: cell.max(1e-12 * s.bbox_diagonal().max(1e-300)),
+            origin,
+            cells: FxHashMap::default(),
+        }
+    }
+
+    fn index(&self, p: DVec3) -> [i64; 3] {
+        ((p - self.origin) / self.cell).floor().as_i64vec3().to_array()
+    }
+
+    fn add(&mut self, p: DVec3) {
+        let k = self.index(p);
+        self.cells.entry(k).or_default().push(p);
+    }
+
+    fn has_within(&self, p: DVec3, r: f64) -> bool {
+        let reach = ((r / self.cell).ceil() as i64).clamp(1, 8);
+        let c = self.index(p);
+        for dx in -reach..=reach {
+            for dy in -reach..=reach {
+                for dz in -reach..=reach {
+                    if let Some(list) = self.cells.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) {
+                        if list.iter().any(|q| (*q - p).length_squared() < r * r) {
+                            return true;
+                        }
+                    }
+                }
+            }
+        }
+        false
+    }
+}
