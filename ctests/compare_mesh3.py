@@ -2,7 +2,8 @@
 """Compare slivermesh's quality meshing with CGAL Mesh_3 (perturb + exude) at comparable tet counts.
 
 For each --input .off (default: the acute-free off/cube.off and off/cross.off):
-  1. `slivermesh mesh INPUT --size H` with H adjusted until about --tets tets;
+  1. `slivermesh mesh INPUT --surface keep --size H` with H adjusted until about --tets tets
+     (the input facets kept as given; --slivermesh-arg=--surface=approximate overrides);
   2. `cgal_mesh3 mesh INPUT --size S` (Polyhedral_mesh_domain_with_features_3, detect_features(),
      facet_angle 25, cell_radius_edge_ratio 2, edge/facet/cell size S, facet distance S/10,
      make_mesh_3 with perturb() and exude()) with S adjusted until its tet count is within --tol of
@@ -37,7 +38,8 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from meshcompare import Failure, check_executable, match_count, run_timed, table  # noqa: E402
+from meshcompare import (Failure, check_executable, keep_surface, match_count,  # noqa: E402
+                         run_timed, table)
 
 
 def off_volume(path):
@@ -86,14 +88,15 @@ def compare_model(args, model, outdir):
 
     def ours_at(h):
         last["ours"] = h
+        extra = keep_surface(args.slivermesh_arg)
         cmd = [args.slivermesh, "mesh", model, "-o", ours_native, "--size", "%.10g" % h,
-               "--stats-json", stats] + args.slivermesh_arg
+               "--stats-json", stats] + extra
         _, wall = run_timed(cmd)
         with open(stats) as f:
             res = json.load(f)
         res.update({"size": h, "wall_seconds": wall,
                     "command": "slivermesh mesh %s --size %.6g %s" % (os.path.basename(model), h,
-                                                                      " ".join(args.slivermesh_arg))})
+                                                                      " ".join(extra))})
         return res
 
     def cgal_at(s):

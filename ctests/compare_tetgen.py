@@ -31,7 +31,8 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from meshcompare import Failure, check_executable, match_count, run_timed, table  # noqa: E402
+from meshcompare import (Failure, check_executable, keep_surface, match_count,  # noqa: E402
+                         run_timed, table)
 
 THRESHOLDS_DEG = (5.0, 10.0, 15.0, 20.0)
 
@@ -188,6 +189,7 @@ def run_tetgen(exe, poly, workdir, volume, quality):
 
 
 def run_ours(exe, poly, workdir, size, extra):
+    extra = keep_surface(extra)  # tetgen keeps the input facets: so do we
     d = os.path.join(workdir, "slivermesh")
     os.makedirs(d, exist_ok=True)
     stem = os.path.join(d, "out")

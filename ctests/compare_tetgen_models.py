@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Quality against `tetgen -pq1.414` on whole models (issue 12), measured on the written meshes.
 
-For each model: `slivermesh mesh MODEL -o out.ele` with the default (automatic) spacing in keep
-mode, then `tetgen -pq1.414a<V>` with V chosen so tetgen's tet count is within --count-tol of
+For each model: `slivermesh mesh MODEL -o out.ele --surface keep` with the default (automatic)
+spacing, then `tetgen -pq1.414a<V>` with V chosen so tetgen's tet count is within --count-tol of
 ours. Both meshes are measured here from their .node/.ele with the same code
 (compare_tetgen.measure). Checks, per model (exit status 1 with FAIL lines otherwise):
   * our mesh has no flat or inverted tet (float determinant; the library checks it exactly);
@@ -24,7 +24,7 @@ import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from compare_tetgen import measure, read_node_ele, run_tetgen  # noqa: E402
-from meshcompare import Failure, match_count, run_timed  # noqa: E402
+from meshcompare import Failure, keep_surface, match_count, run_timed  # noqa: E402
 
 
 def ours(exe, model, workdir):
@@ -32,7 +32,8 @@ def ours(exe, model, workdir):
     os.makedirs(d, exist_ok=True)
     stem = os.path.join(d, "out")
     stats = os.path.join(d, "stats.json")
-    _, seconds = run_timed([exe, "mesh", model, "-o", stem + ".ele", "--stats-json", stats])
+    _, seconds = run_timed([exe, "mesh", model, "-o", stem + ".ele", "--stats-json", stats]
+                           + keep_surface([]))
     with open(stats) as f:
         rep = json.load(f)
     xyz, tets = read_node_ele(stem)

@@ -27,6 +27,15 @@ def run_timed(cmd, cwd=None):
     return proc.stdout, seconds
 
 
+def keep_surface(extra):
+    """`slivermesh mesh` arguments that keep the input facets as given (`--surface keep`: the
+    comparisons mesh the same facets as the other program; the CLI's default for .off/.stl/.ply/
+    .obj is the approximate mode), unless `extra` chooses a surface mode itself."""
+    if any(a == "--surface" or a.startswith("--surface=") for a in extra):
+        return list(extra)
+    return ["--surface", "keep"] + list(extra)
+
+
 def check_executable(name, path):
     if not (path and os.path.isfile(path) and os.access(path, os.X_OK)):
         print("error: %s not found or not executable: %s" % (name, path), file=sys.stderr)

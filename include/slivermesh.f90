@@ -311,7 +311,8 @@ contains
     end do
   end function f_string
 
-  !> sm_set_param with a Fortran string name ("rho0", "sigma0", "seed", ...).
+  !> sm_set_param with a Fortran string name ("rho0", "sigma0", "seed", "surface_mode", ...;
+  !> every name and range: sm_set_param in slivermesh.h).
   function sm_set_param(m, name, value) result(s)
     type(c_ptr), intent(in) :: m
     character(len=*), intent(in) :: name

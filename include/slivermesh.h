@@ -313,7 +313,13 @@ sm_status sm_add_region(sm_mesher *m,
  * radii, the influence of a vertex where segments meet below 60 degrees reaches along its
  * segments and facets; 2 to 8 leave fewer bad tets there for more vertices and time),
  * "improve" (1, the default: flips and smoothing after refinement; 0 keeps the Delaunay
- * mesh, removing only flat or inverted tets).
+ * mesh, removing only flat or inverted tets), "surface_mode" (0, the default: keep, every
+ * input facet is preserved exactly; 1: approximate, the input triangles describe a piecewise
+ * smooth surface whose sharp features are kept and whose boundary is a new triangulation
+ * within surface_distance of it), "feature_angle" (approximate mode: degrees in (0, 180),
+ * default 40; an edge whose two triangles' normals differ by more is a sharp feature),
+ * "surface_distance" (approximate mode: finite, >= 0, absolute length; 0, the default, means
+ * 0.001 x the input's bounding-box diagonal).
  * An unknown name or out-of-range value gives `SM_ERR_INVALID_ARGUMENT`; `sm_last_error`
  * says why (and lists the valid names).
  *
@@ -372,8 +378,10 @@ sm_status sm_set_spacing_batch_cb(sm_mesher *m, sm_spacing_batch_fn f, void *use
 sm_status sm_set_progress_cb(sm_mesher *m, sm_progress_fn f, void *user_data);
 
 /**
- * Meshes the domain: validation, boundary recovery, then quality refinement (unless the
- * "refine" parameter is 0). On success the mesh replaces any previous one; on failure there is
+ * Meshes the domain: validation, boundary recovery (the input facets as given when
+ * "surface_mode" is 0, the default; a new boundary approximating the surface they describe when
+ * it is 1), quality refinement (unless the "refine" parameter is 0), then the improvement pass
+ * (unless "improve" is 0). On success the mesh replaces any previous one; on failure there is
  * no mesh and `sm_last_error` says why: `SM_ERR_INVALID_INPUT` (the domain, naming the facet or
  * vertex), `SM_ERR_SPACING` (a spacing value that is not finite and positive, naming the point),
  * `SM_ERR_CANCELLED` (the progress callback), `SM_ERR_INTERNAL`.

@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Before/after table of the refinement on every model at its default spacing.
+"""Before/after table of the refinement on every model at its default spacing (surface files
+in keep mode: `--surface keep` when the binary has that flag).
 
     scripts/refine-table.py MODELS_DIR BINARY OUT_DIR [--runs N] [--only NAME,...]
 
@@ -32,13 +33,23 @@ def models(root: Path, only):
     return found
 
 
+def keep_args(binary: str):
+    """`--surface keep` when the binary has it (the refinement of the input facets as given;
+    its default for .off files is the approximate mode), nothing for an older binary."""
+    help_text = subprocess.run(
+        [binary, "mesh", "--help"], capture_output=True, text=True, check=True
+    ).stdout
+    return ["--surface", "keep"] if "--surface <MODE>" in help_text else []
+
+
 def run_once(binary: str, model: Path, out: Path):
     mesh = out / f"{model.parent.name}-{model.stem}.mesh"
     stats = out / f"{model.parent.name}-{model.stem}.json"
+    extra = keep_args(binary)
     t0 = time.perf_counter()
     r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     subprocess.run(
-        [binary, "mesh", str(model), "-o", str(mesh), "--stats-json", str(stats)],
+        [binary, "mesh", str(model), "-o", str(mesh), "--stats-json", str(stats)] + extra,
         check=True,
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,

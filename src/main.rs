@@ -45,7 +45,8 @@ enum Command {
     },
     /// Mesh a domain (.poly, .smesh, .off, .stl, .ply, .obj) with quality refinement, or remove the
     /// slivers of an existing mesh (.mesh). Output format by extension (.vtu, .mesh, .msh,
-    /// .node/.ele).
+    /// .node/.ele). Surfaces (.off, .stl, .ply, .obj) are approximated by default, .poly/.smesh
+    /// facets kept (--surface).
     Mesh {
         /// Input domain or existing mesh.
         input: PathBuf,

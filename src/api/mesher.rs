@@ -8,7 +8,7 @@ use super::spacing::{valid_value, Checked, SpacingChoice};
 use crate::geom::MAX_COORD;
 use crate::mesh::TetMesh;
 use crate::plc::{Facet, PlcInput, Region};
-use crate::refine::{self, ConstantSpacing, FnSpacing, MeshError, Progress, Report, Spacing};
+use crate::refine::{ConstantSpacing, FnSpacing, MeshError, Progress, Report, Spacing};
 use glam::DVec3;
 use std::path::Path;
 
@@ -257,7 +257,8 @@ impl Mesher {
         self
     }
 
-    /// Meshes the domain with the stored spacing and progress callback.
+    /// Meshes the domain with the stored spacing and progress callback: `pipeline::mesh`, in the
+    /// parameters' `surface_mode` (default keep), then the improvement pass (`improve`).
     pub fn refine(&mut self) -> Result<&Report, Error> {
         self.refine_with(None, None)
     }
@@ -307,7 +308,7 @@ impl Mesher {
             if let Some(c) = &checked {
                 c.precheck(&self.input.vertices)?;
             }
-            refine::mesh(
+            crate::pipeline::mesh(
                 &self.input,
                 &self.params,
                 checked.as_ref().map(|c| c as &dyn Spacing),
@@ -321,9 +322,7 @@ impl Mesher {
             (Ok(_), None) if cancelled => Err(MeshError::Cancelled),
             (r, None) => r,
         };
-        let (mesh, mut report) = result?;
-        let mesh =
-            crate::improve::finish(mesh, &mut report, Some(&self.input), self.params.improve)?;
+        let (mesh, report) = result?;
         Ok(&self.output.insert(MeshOutput { mesh, report }).report)
     }
 

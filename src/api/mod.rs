@@ -1,7 +1,7 @@
 //! The safe Rust API: what Rust users, the CLI and the C ABI (`ffi`) call.
 //!
 //! - [`Mesher`] (`mesher.rs`): builder for a domain, parameters, spacing and progress; runs
-//!   `refine::mesh` and keeps the result.
+//!   `pipeline::mesh` (the surface mode, refinement, improvement) and keeps the result.
 //! - [`params`]: parameters set and read by name, with range checks that give a reason.
 //! - [`SpacingChoice`] (`spacing.rs`): automatic, constant or user spacing, and the guard that
 //!   turns any spacing value that is not finite and positive into an error naming the point.
@@ -22,7 +22,7 @@ mod spacing;
 pub use error::Error;
 pub use mesher::{Mesher, ProgressFn};
 pub use output::{MeshOutput, QualityFields};
-pub use params::{Params, PARAM_NAMES};
+pub use params::{Params, SurfaceMode, PARAM_NAMES};
 pub use spacing::SpacingChoice;
 
 pub use crate::mesh::TetMesh;

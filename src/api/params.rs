@@ -3,7 +3,7 @@
 
 use super::error::{invalid, Error};
 use crate::geom::{REGULAR_DIHEDRAL, REGULAR_RHO, REGULAR_SIGMA};
-pub use crate::refine::Params;
+pub use crate::refine::{Params, SurfaceMode};
 
 /// Every name [`set_param`] accepts, in documentation order (`"B"` is an alias of
 /// `"size_factor"`).
@@ -21,6 +21,9 @@ pub const PARAM_NAMES: &[&str] = &[
     "refine",
     "small_angle_reach",
     "improve",
+    "surface_mode",
+    "feature_angle",
+    "surface_distance",
 ];
 
 /// Smallest accepted `rho0` (the refiner's own limit, `Params::check`).
@@ -40,8 +43,10 @@ const MAX_EXACT_INT: f64 = 9_007_199_254_740_992.0; // 2^53
 /// [0, 70.5): 0 turns the angle test off), `delta` (in (0, 1)), `b` (> 0), `size_factor` or `B`
 /// (> 0), `seed` (integer in [0, 2^53]), `max_vertices` (integer >= 4), `max_tries`
 /// (integer >= 1), `refine` (0 or 1), `small_angle_reach` (> 0, may be infinite), `improve`
-/// (0 or 1). Integer
-/// parameters must be given as whole numbers.
+/// (0 or 1), `surface_mode` (0 = keep the input facets, 1 = approximate the surface they
+/// describe), `feature_angle` (degrees, in (0, 180): approximate mode's sharp-edge threshold),
+/// `surface_distance` (finite, >= 0: approximate mode's distance bound; 0 = the default, 0.001 x
+/// the bounding-box diagonal). Integer and 0/1 parameters must be given as whole numbers.
 /// The result also passes `Params::check` (the refiner's own validation), so a value accepted
 /// here is never refused by `refine`.
 pub fn set_param(params: &mut Params, name: &str, value: f64) -> Result<(), Error> {
@@ -129,6 +134,38 @@ fn set_unchecked(params: &mut Params, name: &str, value: f64) -> Result<(), Erro
                 }
             }
         }
+        "surface_mode" => {
+            params.surface_mode = match value {
+                0.0 => SurfaceMode::Keep,
+                1.0 => SurfaceMode::Approximate,
+                _ => {
+                    return invalid(format!(
+                        "surface_mode = {value}: must be 0 (keep: every input facet is preserved \
+                         exactly) or 1 (approximate: the input triangles describe a piecewise \
+                         smooth surface, remeshed within surface_distance)"
+                    ))
+                }
+            }
+        }
+        "feature_angle" => {
+            if !(value > 0.0 && value < 180.0) {
+                return invalid(format!(
+                    "feature_angle = {value} is out of range (0, 180) degrees: an edge whose two \
+                     triangles' normals differ by more than this is a sharp feature (default 40)"
+                ));
+            }
+            params.feature_angle = value;
+        }
+        "surface_distance" => {
+            if !(value.is_finite() && value >= 0.0) {
+                return invalid(format!(
+                    "surface_distance = {value}: must be finite and >= 0: how far the \
+                     approximate mode's boundary may lie from the input surface (absolute \
+                     length; 0 = the default, 0.001 x the bounding-box diagonal)"
+                ));
+            }
+            params.surface_distance = value;
+        }
         "refine" => {
             params.refine = match value {
                 0.0 => false,
@@ -166,6 +203,12 @@ pub fn get_param(params: &Params, name: &str) -> Result<f64, Error> {
         "refine" => f64::from(u8::from(params.refine)),
         "improve" => f64::from(u8::from(params.improve)),
         "small_angle_reach" => params.small_angle_reach,
+        "surface_mode" => match params.surface_mode {
+            SurfaceMode::Keep => 0.0,
+            SurfaceMode::Approximate => 1.0,
+        },
+        "feature_angle" => params.feature_angle,
+        "surface_distance" => params.surface_distance,
         _ => {
             return invalid(format!(
                 "unknown parameter \"{name}\"; valid names: {}",
@@ -234,6 +277,9 @@ mod tests {
             ("refine", 0.0),
             ("small_angle_reach", 2.0),
             ("improve", 0.0),
+            ("surface_mode", 1.0),
+            ("feature_angle", 30.0),
+            ("surface_distance", 0.01),
         ];
         assert_eq!(values.len(), PARAM_NAMES.len());
         for (name, v) in values {
@@ -244,6 +290,7 @@ mod tests {
         assert_eq!(p.seed, 42);
         assert!(!p.refine);
         assert!(!p.improve);
+        assert_eq!(p.surface_mode, SurfaceMode::Approximate);
         assert!(set_param(&mut p, "improve", 0.5).is_err());
     }
 

@@ -220,3 +220,133 @@ fn unit_cube_meshes() {
     let q = QualityFields::of(mesh);
     assert_eq!(q.rho.len(), mesh.tets.len());
 }
+
+#[test]
+fn surface_parameters_by_name() {
+    let mut m = cube();
+    assert_eq!(m.param("surface_mode").unwrap(), 0.0, "the default is keep");
+    assert_eq!(m.param("feature_angle").unwrap(), 40.0);
+    assert_eq!(m.param("surface_distance").unwrap(), 0.0);
+    m.set_param("surface_mode", 1.0).unwrap();
+    assert_eq!(m.params().surface_mode, SurfaceMode::Approximate);
+    assert_eq!(m.param("surface_mode").unwrap(), 1.0);
+    m.set_param("feature_angle", 25.5).unwrap();
+    assert_eq!(m.param("feature_angle").unwrap(), 25.5);
+    m.set_param("surface_distance", 0.002).unwrap();
+    assert_eq!(m.param("surface_distance").unwrap(), 0.002);
+    m.set_param("surface_distance", 0.0).unwrap();
+    m.set_param("surface_distance", 0.002).unwrap();
+    m.set_param("surface_mode", 0.0).unwrap();
+    assert_eq!(m.params().surface_mode, SurfaceMode::Keep);
+    m.set_param("surface_mode", 1.0).unwrap();
+
+    // Refused values name the parameter, say what is accepted, and change nothing.
+    let before = m.params().clone();
+    for (name, value, needles) in [
+        (
+            "surface_mode",
+            2.0,
+            &["surface_mode", "0 (keep", "1 (approximate"][..],
+        ),
+        ("surface_mode", -1.0, &["surface_mode", "0 (keep"][..]),
+        ("surface_mode", 0.5, &["surface_mode", "1 (approximate"][..]),
+        ("surface_mode", f64::NAN, &["surface_mode", "NaN"][..]),
+        ("feature_angle", 0.0, &["feature_angle", "(0, 180)"][..]),
+        ("feature_angle", 180.0, &["feature_angle", "(0, 180)"][..]),
+        ("feature_angle", 200.0, &["feature_angle", "(0, 180)"][..]),
+        ("feature_angle", -5.0, &["feature_angle", "(0, 180)"][..]),
+        (
+            "feature_angle",
+            f64::INFINITY,
+            &["feature_angle", "(0, 180)"][..],
+        ),
+        ("feature_angle", f64::NAN, &["feature_angle", "NaN"][..]),
+        (
+            "surface_distance",
+            -1.0,
+            &["surface_distance", ">= 0", "0 = the default"][..],
+        ),
+        (
+            "surface_distance",
+            f64::INFINITY,
+            &["surface_distance", "finite"][..],
+        ),
+        (
+            "surface_distance",
+            f64::NAN,
+            &["surface_distance", "NaN"][..],
+        ),
+    ] {
+        let e = msg(m.set_param(name, value));
+        for n in needles {
+            assert!(e.contains(n), "{name} = {value}: \"{e}\" lacks \"{n}\"");
+        }
+        assert_eq!(
+            m.params(),
+            &before,
+            "{name} = {value} changed the parameters"
+        );
+    }
+    // Close to the ends of the ranges.
+    m.set_param("feature_angle", 1e-9).unwrap();
+    m.set_param("feature_angle", 179.999).unwrap();
+    m.set_param("surface_distance", 1e30).unwrap();
+    m.params().check().unwrap();
+    let e = msg(m.set_param("surface", 1.0));
+    for n in ["surface_mode", "feature_angle", "surface_distance"] {
+        assert!(e.contains(n), "{e} lacks {n}");
+    }
+}
+
+/// The unit cube's boundary as 12 triangles (a closed triangulated surface, as an .off gives).
+fn triangulated_cube() -> Mesher {
+    let mut m = Mesher::new();
+    let v: Vec<DVec3> = (0..8)
+        .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
+        .collect();
+    m.add_vertices(&v).unwrap();
+    for f in [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ] {
+        m.add_facet(&[f[0], f[1], f[2]], 1).unwrap();
+        m.add_facet(&[f[0], f[2], f[3]], 1).unwrap();
+    }
+    m
+}
+
+/// `Mesher::refine` runs `pipeline::mesh`: keep mode (the default) gives no surface report;
+/// approximate mode goes to `approx::mesh`.
+#[test]
+fn refine_dispatches_on_the_surface_mode() {
+    let mut m = triangulated_cube();
+    m.set_spacing_constant(0.3).unwrap();
+    let r = m.refine();
+    if mesh_pending(&r) {
+        return;
+    }
+    let report = r.unwrap().clone();
+    assert!(report.n_tets > 0);
+    assert!(report.surface.is_none(), "keep mode has no surface report");
+
+    m.set_param("surface_mode", 1.0).unwrap();
+    match m.refine() {
+        Ok(report) => {
+            // TODO(approx): require Ok once approx::mesh lands.
+            assert!(report.n_tets > 0);
+            assert!(
+                report.surface.is_some(),
+                "approximate mode reports its surface"
+            );
+        }
+        Err(e) => {
+            let e = e.to_string();
+            assert!(e.contains("approximate"), "{e}");
+            assert!(m.output().is_none());
+        }
+    }
+}

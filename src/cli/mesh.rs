@@ -5,8 +5,11 @@ use slivermesh::geom::TetQuality;
 use slivermesh::improve;
 use slivermesh::io::{self, CellField, ReadOptions};
 use slivermesh::mesh::TetMesh;
+use slivermesh::pipeline;
 use slivermesh::plc::{Facet, PlcInput, Region};
-use slivermesh::refine::{self, ConstantSpacing, FnSpacing, Params, Report, Spacing};
+use slivermesh::refine::{
+    self, ConstantSpacing, FnSpacing, Params, Report, Spacing, SurfaceMode, SurfaceReport,
+};
 use slivermesh::DVec3;
 use std::io::IsTerminal;
 use std::path::Path;
@@ -48,15 +51,65 @@ pub struct MeshOptions {
     /// inverted tets are still removed; the report says whether the output is Delaunay).
     #[arg(long)]
     pub no_improve: bool,
+    /// keep: every input facet is preserved exactly; approximate: the input triangles describe
+    /// a piecewise smooth surface, its sharp features are kept and the boundary is a new
+    /// triangulation within --surface-distance of it. Default: approximate for .off, .stl,
+    /// .ply and .obj, keep for .poly and .smesh.
+    #[arg(long, value_enum, value_name = "MODE")]
+    pub surface: Option<SurfaceArg>,
+    /// Approximate mode: an edge whose two triangles' normals differ by more than DEG degrees
+    /// is a sharp feature, kept in the output (in (0, 180); default 40).
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
+    pub feature_angle: Option<f64>,
+    /// Approximate mode: how far the output boundary may lie from the input surface (absolute
+    /// length; default 0.001 x the input's bounding-box diagonal).
+    #[arg(long, value_name = "D", allow_negative_numbers = true)]
+    pub surface_distance: Option<f64>,
+}
+
+/// `--surface`: how the input facets bound the domain (`refine::SurfaceMode`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SurfaceArg {
+    /// Every input facet is preserved exactly.
+    Keep,
+    /// The input triangles describe a piecewise smooth surface that the boundary approximates.
+    Approximate,
+}
+
+impl From<SurfaceArg> for SurfaceMode {
+    fn from(a: SurfaceArg) -> Self {
+        match a {
+            SurfaceArg::Keep => SurfaceMode::Keep,
+            SurfaceArg::Approximate => SurfaceMode::Approximate,
+        }
+    }
 }
 
 impl MeshOptions {
-    fn params(&self) -> Params {
+    /// The surface mode for `input`: `--surface` when given, else approximate for a surface
+    /// file (.off/.stl/.ply/.obj) and keep for anything else (.poly/.smesh, and an existing
+    /// .mesh, whose boundary is always kept).
+    pub fn surface_mode(&self, input: &Path) -> SurfaceMode {
+        match self.surface {
+            Some(a) => a.into(),
+            None if io::is_surface_file(input) => SurfaceMode::Approximate,
+            None => SurfaceMode::Keep,
+        }
+    }
+
+    fn params(&self, input: &Path) -> Params {
         let mut p = Params {
             refine: !self.no_refine,
             improve: !self.no_improve,
+            surface_mode: self.surface_mode(input),
             ..Params::default()
         };
+        if let Some(v) = self.feature_angle {
+            p.feature_angle = v;
+        }
+        if let Some(v) = self.surface_distance {
+            p.surface_distance = v;
+        }
         if let Some(v) = self.rho {
             p.rho0 = v;
         }
@@ -88,14 +141,29 @@ pub fn run_mesh(
     quality_svg: Option<&Path>,
     opts: &MeshOptions,
 ) -> Result<(), String> {
-    let params = opts.params();
+    let params = opts.params(input);
     params.check()?;
+    if params.surface_mode == SurfaceMode::Keep
+        && (opts.feature_angle.is_some() || opts.surface_distance.is_some())
+    {
+        eprintln!(
+            "warning: --feature-angle and --surface-distance only apply to --surface approximate \
+             (this run keeps the input facets)"
+        );
+    }
     let constant = opts.size.map(ConstantSpacing);
     let spacing = constant.as_ref().map(|s| s as &dyn Spacing);
     let is_mesh = input
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("mesh"));
     let (mesh, report) = if is_mesh {
+        if opts.surface == Some(SurfaceArg::Approximate) {
+            return Err(format!(
+                "{}: --surface approximate does not apply to an existing mesh (.mesh): its \
+                 boundary is kept as it is",
+                input.display()
+            ));
+        }
         let existing = io::read_mesh(input).map_err(|e| e.to_string())?;
         let (mesh, mut report) =
             refine::existing::remove_slivers(&existing, &params).map_err(|e| e.to_string())?;
@@ -112,14 +180,12 @@ pub fn run_mesh(
             },
         )
         .map_err(|e| e.to_string())?;
-        let (mesh, mut report) = mesh_with_progress(&plc, &params, spacing)?;
-        let mesh = improve::finish(mesh, &mut report, Some(&plc), params.improve)
-            .map_err(|e| e.to_string())?;
-        (mesh, report)
+        mesh_with_progress(&plc, &params, spacing)?
     };
     finish(&mesh, &report, output, stats_json, quality_svg)
 }
 
+/// `pipeline::mesh` (the surface mode, refinement, improvement) with a spinner on a terminal.
 fn mesh_with_progress(
     plc: &PlcInput,
     params: &Params,
@@ -142,7 +208,7 @@ fn mesh_with_progress(
         }
         true
     };
-    let r = refine::mesh(plc, params, spacing, Some(&mut progress));
+    let r = pipeline::mesh(plc, params, spacing, Some(&mut progress));
     if let Some(b) = bar {
         b.finish_and_clear();
     }
@@ -157,6 +223,9 @@ fn finish(
     quality_svg: Option<&Path>,
 ) -> Result<(), String> {
     println!("{}", report.table());
+    if let Some(surface) = &report.surface {
+        println!("{}", surface_table(surface));
+    }
     if let Some(path) = stats_json {
         let json = serde_json::to_string_pretty(report).map_err(|e| e.to_string())?;
         std::fs::write(path, json).map_err(|e| format!("{}: {e}", path.display()))?;
@@ -168,6 +237,43 @@ fn finish(
     // Measured on the mesh as written, the table `slivermesh quality` prints for that file.
     let name = output.map_or("the output mesh".to_string(), |p| p.display().to_string());
     super::quality::report_output(mesh, &name, quality_svg)
+}
+
+/// The report's "surface" section (approximate mode), in the style of `Report::table`.
+fn surface_table(s: &SurfaceReport) -> String {
+    let mut out = String::from("surface (approximate mode)\n");
+    let mut row = |k: &str, v: String| out.push_str(&format!("  {k:<28} {v}\n"));
+    row("distance bound", format!("{:.4e}", s.surface_distance));
+    row(
+        "hausdorff in->out / out->in",
+        format!(
+            "{:.4e} / {:.4e}",
+            s.hausdorff_input_to_output, s.hausdorff_output_to_input
+        ),
+    );
+    row("feature distance", format!("{:.4e}", s.feature_distance));
+    row(
+        "relative volume difference",
+        format!("{:+.4e}", s.relative_volume_difference),
+    );
+    row(
+        "feature edges / polylines",
+        format!("{} / {}", s.n_feature_edges, s.n_feature_polylines),
+    );
+    row(
+        "corners / patches",
+        format!("{} / {}", s.n_corners, s.n_patches),
+    );
+    row(
+        "small corners / bad near",
+        format!("{} / {}", s.n_small_corners, s.n_bad_near_small_corners),
+    );
+    row(
+        "surface vertices / triangles",
+        format!("{} / {}", s.n_surface_vertices, s.n_surface_triangles),
+    );
+    row("time surface (s)", format!("{:.3}", s.seconds_surface));
+    out
 }
 
 /// Writes the mesh, with per-tet quality as cell data (radius-edge ratio, sigma, min dihedral)
@@ -262,9 +368,7 @@ pub fn run_demo() -> Result<(), String> {
     let plc = demo_model();
     let f = FnSpacing(|p: DVec3| 0.02 + 0.1 * p.length());
     let params = Params::default();
-    let (mesh, mut report) = mesh_with_progress(&plc, &params, Some(&f))?;
-    let mesh = improve::finish(mesh, &mut report, Some(&plc), params.improve)
-        .map_err(|e| e.to_string())?;
+    let (mesh, report) = mesh_with_progress(&plc, &params, Some(&f))?;
     finish(
         &mesh,
         &report,
@@ -272,4 +376,92 @@ pub fn run_demo() -> Result<(), String> {
         None,
         None,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(clap::Parser)]
+    struct Opts {
+        #[command(flatten)]
+        mesh: MeshOptions,
+    }
+
+    fn parse(args: &[&str]) -> Result<MeshOptions, clap::Error> {
+        Opts::try_parse_from(std::iter::once("mesh").chain(args.iter().copied())).map(|o| o.mesh)
+    }
+
+    #[test]
+    fn surface_mode_defaults_by_file_type_and_the_flag_wins() {
+        let none = parse(&[]).unwrap();
+        for f in ["a.off", "a.STL", "a.ply", "a.obj"] {
+            assert_eq!(
+                none.surface_mode(Path::new(f)),
+                SurfaceMode::Approximate,
+                "{f}"
+            );
+        }
+        for f in ["a.poly", "a.smesh", "a.mesh"] {
+            assert_eq!(none.surface_mode(Path::new(f)), SurfaceMode::Keep, "{f}");
+        }
+        let keep = parse(&["--surface", "keep"]).unwrap();
+        assert_eq!(keep.surface_mode(Path::new("a.off")), SurfaceMode::Keep);
+        let approx = parse(&["--surface=approximate"]).unwrap();
+        assert_eq!(
+            approx.surface_mode(Path::new("a.poly")),
+            SurfaceMode::Approximate
+        );
+        assert!(parse(&["--surface", "smooth"]).is_err());
+    }
+
+    #[test]
+    fn surface_flags_reach_the_parameters() {
+        let o = parse(&["--feature-angle", "30", "--surface-distance", "0.01"]).unwrap();
+        let p = o.params(Path::new("a.off"));
+        assert_eq!(p.surface_mode, SurfaceMode::Approximate);
+        assert_eq!(p.feature_angle, 30.0);
+        assert_eq!(p.surface_distance, 0.01);
+        p.check().unwrap();
+        let d = parse(&[]).unwrap().params(Path::new("a.off"));
+        assert_eq!(d.feature_angle, Params::default().feature_angle);
+        assert_eq!(d.surface_distance, 0.0);
+        for (flag, value, name) in [
+            ("--feature-angle", "200", "feature_angle"),
+            ("--feature-angle", "0", "feature_angle"),
+            ("--surface-distance", "-1", "surface_distance"),
+        ] {
+            let bad = parse(&[flag, value]).unwrap();
+            let e = bad.params(Path::new("a.off")).check().unwrap_err();
+            assert!(e.contains(name), "{e}");
+        }
+    }
+
+    #[test]
+    fn surface_section_lists_the_figures() {
+        let t = surface_table(&SurfaceReport {
+            surface_distance: 0.0017,
+            n_feature_edges: 12,
+            n_feature_polylines: 12,
+            n_corners: 8,
+            n_patches: 6,
+            n_surface_triangles: 345,
+            ..SurfaceReport::default()
+        });
+        assert!(t.starts_with("surface"), "{t}");
+        for needle in [
+            "distance bound",
+            "1.7000e-3",
+            "hausdorff",
+            "feature distance",
+            "relative volume difference",
+            "12 / 12",
+            "8 / 6",
+            "/ 345",
+            "time surface",
+        ] {
+            assert!(t.contains(needle), "{t} lacks {needle}");
+        }
+    }
 }

@@ -6,8 +6,10 @@ use super::status::*;
 use crate::refine::Spacing;
 use std::ffi::CString;
 
-/// Meshes the domain: validation, boundary recovery, then quality refinement (unless the
-/// "refine" parameter is 0). On success the mesh replaces any previous one; on failure there is
+/// Meshes the domain: validation, boundary recovery (the input facets as given when
+/// "surface_mode" is 0, the default; a new boundary approximating the surface they describe when
+/// it is 1), quality refinement (unless the "refine" parameter is 0), then the improvement pass
+/// (unless "improve" is 0). On success the mesh replaces any previous one; on failure there is
 /// no mesh and `sm_last_error` says why: `SM_ERR_INVALID_INPUT` (the domain, naming the facet or
 /// vertex), `SM_ERR_SPACING` (a spacing value that is not finite and positive, naming the point),
 /// `SM_ERR_CANCELLED` (the progress callback), `SM_ERR_INTERNAL`.

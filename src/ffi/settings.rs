@@ -18,7 +18,13 @@ use std::ffi::{c_char, c_void};
 /// radii, the influence of a vertex where segments meet below 60 degrees reaches along its
 /// segments and facets; 2 to 8 leave fewer bad tets there for more vertices and time),
 /// "improve" (1, the default: flips and smoothing after refinement; 0 keeps the Delaunay
-/// mesh, removing only flat or inverted tets).
+/// mesh, removing only flat or inverted tets), "surface_mode" (0, the default: keep, every
+/// input facet is preserved exactly; 1: approximate, the input triangles describe a piecewise
+/// smooth surface whose sharp features are kept and whose boundary is a new triangulation
+/// within surface_distance of it), "feature_angle" (approximate mode: degrees in (0, 180),
+/// default 40; an edge whose two triangles' normals differ by more is a sharp feature),
+/// "surface_distance" (approximate mode: finite, >= 0, absolute length; 0, the default, means
+/// 0.001 x the input's bounding-box diagonal).
 /// An unknown name or out-of-range value gives `SM_ERR_INVALID_ARGUMENT`; `sm_last_error`
 /// says why (and lists the valid names).
 ///
