@@ -163,13 +163,12 @@ def read_msh41(path):
             elif s == "$Nodes":
                 n_blocks = int(next(lines).split()[0])
                 for _ in range(n_blocks):
-                    dim, _tag, parametric, n = (int(x) for x in next(lines).split())
+                    _dim, _tag, _parametric, n = (int(x) for x in next(lines).split())
                     tags = [int(next(lines)) for _ in range(n)]
                     for tag in tags:
-                        c = next(lines).split()
+                        c = next(lines).split()  # x y z, then parametric coordinates if any
                         index[tag] = len(xyz)
                         xyz.append((float(c[0]), float(c[1]), float(c[2])))
-                    del dim, parametric  # parametric coordinates follow x y z on the same line
             elif s == "$Elements":
                 n_blocks = int(next(lines).split()[0])
                 for _ in range(n_blocks):
