@@ -2,8 +2,11 @@
 // harness"), and a VTK-based measurer so both meshes are judged by the same code.
 //
 //   cgal_mesh3 mesh INPUT.off --size H [--edge-size E] [--facet-size F] [--facet-distance D]
-//              [--facet-angle 25] [--radius-edge 2] [--no-perturb] [--no-exude] [--vtu OUT.vtu]
-//     Meshes the polyhedron with Polyhedral_mesh_domain_with_features_3 (detect_features()),
+//              [--facet-angle 25] [--radius-edge 2] [--feature-angle 60] [--no-perturb]
+//              [--no-exude] [--vtu OUT.vtu]
+//     Meshes the polyhedron with Polyhedral_mesh_domain_with_features_3 (detect_features(A):
+//     an edge is a feature when its two faces' normals differ by more than A degrees, default
+//     CGAL's 60),
 //     Mesh_criteria_3 (edge_size, facet_angle, facet_size, facet_distance,
 //     cell_radius_edge_ratio, cell_size) and make_mesh_3 with perturb() and exude() (CGAL's
 //     defaults: no time limit, no target bound, so both optimisers run as long as they improve the
@@ -73,7 +76,7 @@ struct TetMesh {
 struct Options {
   std::string mode, input, vtu_out;
   double size = 0.0, edge_size = 0.0, facet_size = 0.0, facet_distance = 0.0;
-  double facet_angle = 25.0, radius_edge = 2.0;
+  double facet_angle = 25.0, radius_edge = 2.0, feature_angle = 60.0;
   bool perturb = true, exude = true;
 };
 
@@ -81,7 +84,7 @@ struct Options {
   std::cerr << "error: " << why << "\n"
             << "usage: cgal_mesh3 mesh INPUT.off --size H [--edge-size E] [--facet-size F]\n"
             << "                  [--facet-distance D] [--facet-angle DEG] [--radius-edge R]\n"
-            << "                  [--no-perturb] [--no-exude] [--vtu OUT.vtu]\n"
+            << "                  [--feature-angle DEG] [--no-perturb] [--no-exude] [--vtu OUT.vtu]\n"
             << "       cgal_mesh3 measure MESH.vtu [--vtu OUT.vtu]\n";
   std::exit(2);
 }
@@ -113,6 +116,7 @@ Options parse_args(int argc, char** argv) {
     else if (a == "--facet-distance") o.facet_distance = parse_positive(a, value());
     else if (a == "--facet-angle") o.facet_angle = parse_positive(a, value());
     else if (a == "--radius-edge") o.radius_edge = parse_positive(a, value());
+    else if (a == "--feature-angle") o.feature_angle = parse_positive(a, value());
     else if (a == "--no-perturb") o.perturb = false;
     else if (a == "--no-exude") o.exude = false;
     else usage("unknown option '" + a + "'");
@@ -249,9 +253,10 @@ void print_json(const Options& o, const TetMesh& m, const tq::MeshQuality& mq,
   if (o.mode == "mesh")
     std::printf("  \"size\": %.17g,\n  \"edge_size\": %.17g,\n  \"facet_size\": %.17g,\n"
                 "  \"facet_distance\": %.17g,\n  \"facet_angle\": %.17g,\n"
-                "  \"cell_radius_edge_ratio\": %.17g,\n  \"perturb\": %s,\n  \"exude\": %s,\n",
+                "  \"cell_radius_edge_ratio\": %.17g,\n  \"feature_angle\": %.17g,\n"
+                "  \"perturb\": %s,\n  \"exude\": %s,\n",
                 o.size, o.edge_size, o.facet_size, o.facet_distance, o.facet_angle,
-                o.radius_edge, o.perturb ? "true" : "false", o.exude ? "true" : "false");
+                o.radius_edge, o.feature_angle, o.perturb ? "true" : "false", o.exude ? "true" : "false");
   std::printf("%s", timings.c_str());
   std::printf("  \"n_vertices\": %zu,\n  \"n_tets\": %zu,\n  \"n_inverted\": %zu,\n"
               "  \"volume\": %.17g,\n  \"min_dihedral_deg\": %.17g,\n"
@@ -280,7 +285,7 @@ int run(const Options& o) {
 
     const auto t1 = std::chrono::steady_clock::now();
     Mesh_domain domain(polyhedron);
-    domain.detect_features();
+    domain.detect_features(o.feature_angle);
     Mesh_criteria criteria(params::edge_size = o.edge_size, params::facet_angle = o.facet_angle,
                            params::facet_size = o.facet_size,
                            params::facet_distance = o.facet_distance,
