@@ -35,7 +35,10 @@ impl Curve {
     /// The point at arc length `s` (clamped to the curve).
     pub fn point_at(&self, s: f64) -> DVec3 {
         let s = s.clamp(0.0, self.length());
-        let k = self.cum.partition_point(|&c| c <= s).clamp(1, self.cum.len() - 1);
+        let k = self
+            .cum
+            .partition_point(|&c| c <= s)
+            .clamp(1, self.cum.len() - 1);
         let (s0, s1) = (self.cum[k - 1], self.cum[k]);
         let t = if s1 > s0 { (s - s0) / (s1 - s0) } else { 0.0 };
         self.points[k - 1].lerp(self.points[k], t)
@@ -106,7 +109,12 @@ impl FeatureCurves {
             }
             let mut patches: Vec<u32> = ids
                 .windows(2)
-                .flat_map(|w| edge_patches.get(&key(w[0], w[1])).cloned().unwrap_or_default())
+                .flat_map(|w| {
+                    edge_patches
+                        .get(&key(w[0], w[1]))
+                        .cloned()
+                        .unwrap_or_default()
+                })
                 .collect();
             patches.sort_unstable();
             patches.dedup();
@@ -131,6 +139,14 @@ impl FeatureCurves {
         }
     }
 
+    /// Shrinks every protecting ball to at most `radius` (inside one the surface is not
+    /// refined, so its size bounds how far the boundary may stray there).
+    pub fn cap_protect_radius(&mut self, radius: f64) {
+        for c in &mut self.corners {
+            c.protect_radius = c.protect_radius.min(radius);
+        }
+    }
+
     /// Small corners (angle below [`SMALL_CORNER_DEG`]).
     pub fn small_corners(&self) -> impl Iterator<Item = &Corner> {
         self.corners.iter().filter(|c| c.protect_radius > 0.0)
@@ -143,8 +159,7 @@ fn key(a: u32, b: u32) -> [u32; 2] {
 
 /// Patches of the triangles around every feature edge.
 fn edge_patches(s: &InputSurface, f: &Features) -> FxHashMap<[u32; 2], Vec<u32>> {
-    let mut out: FxHashMap<[u32; 2], Vec<u32>> =
-        f.edges.iter().map(|&e| (e, Vec::new())).collect();
+    let mut out: FxHashMap<[u32; 2], Vec<u32>> = f.edges.iter().map(|&e| (e, Vec::new())).collect();
     for (t, tri) in s.triangles.iter().enumerate() {
         for j in 0..3 {
             if let Some(list) = out.get_mut(&key(tri[j], tri[(j + 1) % 3])) {

@@ -16,24 +16,33 @@ use glam::DVec3;
 /// as close as the distance bound would cost millions of closest-point queries); every
 /// triangle is also cut into at least [`MIN_PIECES`] along each edge, so each output triangle
 /// is sampled inside, where it is farthest from a curved input.
-const HAUSDORFF_SPACING: f64 = 1.0 / 400.0;
+const HAUSDORFF_SPACING: f64 = 1.0 / 200.0;
 const MIN_PIECES: usize = 3;
 
 /// Largest distance from samples of `from` to `to`.
 fn one_sided(from: &InputSurface, to: &InputSurface, spacing: f64) -> f64 {
     let oracle = SurfaceOracle::new(to);
-    samples_per_edge_at_least(from, spacing, MIN_PIECES)
-        .into_iter()
-        .filter_map(|p| oracle.closest(p))
-        .map(|c| c.distance)
-        .fold(0.0, f64::max)
+    let mut worst = (0.0, DVec3::ZERO);
+    for p in samples_per_edge_at_least(from, spacing, MIN_PIECES) {
+        if let Some(c) = oracle.closest(p) {
+            if c.distance > worst.0 {
+                worst = (c.distance, p);
+            }
+        }
+    }
+    if std::env::var("SM_DEBUG").is_ok() {
+        eprintln!("hausdorff worst {:.3e} at {:?}", worst.0, worst.1);
+    }
+    worst.0
 }
 
 /// Points per input feature edge where its distance to the output's feature edges is taken.
 const FEATURE_EDGE_SAMPLES: usize = 8;
 
 pub fn surface_report(r: &Remeshed, mesh: &TetMesh) -> SurfaceReport {
-    let out = InputSurface::from_triangles(mesh.vertices.clone(), mesh.boundary.clone());
+    // The output boundary is the remeshed triangles subdivided in their own planes (keep mode
+    // on them): the same surface, with far fewer triangles to sample.
+    let out = remeshed_surface(r);
     let spacing = HAUSDORFF_SPACING * r.surface.bbox_diagonal();
     let out_volume: f64 = mesh
         .tets
@@ -65,6 +74,16 @@ pub fn surface_report(r: &Remeshed, mesh: &TetMesh) -> SurfaceReport {
     }
 }
 
+fn remeshed_surface(r: &Remeshed) -> InputSurface {
+    let triangles = r
+        .boundary
+        .facets
+        .iter()
+        .map(|f| [f.polygons[0][0], f.polygons[0][1], f.polygons[0][2]])
+        .collect();
+    InputSurface::from_triangles(r.boundary.vertices.clone(), triangles)
+}
+
 /// Largest distance from a sample of an input feature edge to the nearest output feature edge
 /// (brute force over the output's feature edges, which number a few thousand).
 fn feature_distance(r: &Remeshed) -> f64 {
@@ -83,6 +102,9 @@ fn feature_distance(r: &Remeshed) -> f64 {
                 .iter()
                 .map(|&(u, v)| point_segment_distance(p, u, v))
                 .fold(f64::INFINITY, f64::min);
+            if d > worst && std::env::var("SM_DEBUG").is_ok() {
+                eprintln!("feature worst {d:.3e} at {p:?} (edge {e:?})");
+            }
             worst = worst.max(d);
         }
     }

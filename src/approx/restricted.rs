@@ -27,9 +27,9 @@ use crate::refine::{MeshError, Spacing};
 use crate::surface::oracle::{Side, SurfaceOracle};
 use crate::surface::InputSurface;
 use glam::DVec3;
-use rustc_hash::{FxHashMap, FxHashSet};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use rustc_hash::{FxHashMap, FxHashSet};
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
@@ -75,6 +75,21 @@ struct Restricted {
     centre: DVec3,
     radius: f64,
     triangle: u32,
+}
+
+/// Why a restricted facet is refined.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Bad {
+    No,
+    /// A vertex is off the patch its surface centre lies on (and off that patch's curves).
+    Topology,
+    /// Surface ball larger than f.
+    Size,
+    Angle,
+    /// Circumcentre too far from the surface centre.
+    Distance,
+    /// It breaks the extracted boundary (a vertex off the surface, a non-manifold edge).
+    Boundary,
 }
 
 /// A bad facet waiting in the queue: larger surface balls first, ties by vertices.
@@ -143,7 +158,7 @@ fn key3(mut f: [u32; 3]) -> [u32; 3] {
 }
 
 /// Smallest angle of triangle (a, b, c), degrees.
-fn min_angle_deg(a: DVec3, b: DVec3, c: DVec3) -> f64 {
+pub fn min_angle_deg(a: DVec3, b: DVec3, c: DVec3) -> f64 {
     let angle = |p: DVec3, q: DVec3, r: DVec3| {
         let (u, v) = (q - p, r - p);
         u.cross(v).length().atan2(u.dot(v)).to_degrees()
@@ -216,7 +231,8 @@ impl<'a> SurfaceMesher<'a> {
     fn f(&mut self, p: DVec3) -> f64 {
         let v = self.spacing.at(p);
         if !(v.is_finite() && v > 0.0) {
-            self.bad_spacing.get_or_insert(MeshError::BadSpacing { point: p, value: v });
+            self.bad_spacing
+                .get_or_insert(MeshError::BadSpacing { point: p, value: v });
             return f64::INFINITY;
         }
         v
@@ -225,7 +241,13 @@ impl<'a> SurfaceMesher<'a> {
     /// The spacing at the surface's vertices, median (the sample grid's cell size).
     fn typical_spacing(&mut self) -> f64 {
         let step = (self.surface.vertices.len() / 64).max(1);
-        let pts: Vec<DVec3> = self.surface.vertices.iter().step_by(step).copied().collect();
+        let pts: Vec<DVec3> = self
+            .surface
+            .vertices
+            .iter()
+            .step_by(step)
+            .copied()
+            .collect();
         let mut v: Vec<f64> = pts.into_iter().map(|p| self.f(p)).collect();
         v.sort_by(f64::total_cmp);
         v.get(v.len() / 2).copied().unwrap_or(1.0)
@@ -327,7 +349,7 @@ impl<'a> SurfaceMesher<'a> {
             }
             for (t, i) in problems {
                 if let Some(r) = self.facet_at(t, i) {
-                    self.insert_surface_point(r, t);
+                    self.insert_surface_point(r, t, Bad::Boundary);
                 }
             }
         }
@@ -397,10 +419,9 @@ impl<'a> SurfaceMesher<'a> {
         let curve = &self.curves.curves[ss.curve as usize];
         let split = forced
             || self.dt.find_edge(k[0], k[1]).is_none()
-            || (!self.near_small_corner((a + b) / 2.0)
-                && ((a - b).length() > self.f((a + b) / 2.0)
-                    || curve.chord_deviation(ss.s[0], ss.s[1]) > self.criteria.distance
-                    || self.encroached(k, a, b)));
+            || (a - b).length() > self.f((a + b) / 2.0)
+            || curve.chord_deviation(ss.s[0], ss.s[1]) > self.criteria.distance
+            || (!self.near_small_corner((a + b) / 2.0) && self.encroached(k, a, b));
         if split {
             self.split_subseg(k, ss);
         }
@@ -431,7 +452,10 @@ impl<'a> SurfaceMesher<'a> {
             return;
         }
         let is_corner = |v: u32| matches!(self.loc[v as usize], Loc::Corner(_));
-        let shell = |d: f64| 2f64.powf((d / 2.0).log2().round()).clamp(0.25 * d, 0.75 * d);
+        let shell = |d: f64| {
+            2f64.powf((d / 2.0).log2().round())
+                .clamp(0.25 * d, 0.75 * d)
+        };
         let s = match (is_corner(ss.ends[0]), is_corner(ss.ends[1])) {
             (true, false) => ss.s[0] + shell(len),
             (false, true) => ss.s[1] - shell(len),
@@ -538,27 +562,29 @@ impl<'a> SurfaceMesher<'a> {
     }
 
     fn is_bad(&mut self, r: &Restricted) -> bool {
-        self.badness(r) != 0
+        self.badness(r) != Bad::No
     }
 
-    /// 0 good, 1 topology, 2 size, 3 angle, 4 distance.
-    fn badness(&mut self, r: &Restricted) -> u8 {
+    /// Which criterion a restricted facet fails first (angles are not enforced next to a
+    /// small corner).
+    fn badness(&mut self, r: &Restricted) -> Bad {
         let patch = self.patch_of[r.triangle as usize];
         if !r.vertices.iter().all(|&v| self.on_patch(v, patch)) {
-            return 1;
+            return Bad::Topology;
         }
         if r.radius > self.f(r.centre) {
-            return 2;
+            return Bad::Size;
         }
         let [a, b, c] = r.vertices.map(|v| self.dt.point(v));
         let protected = [a, b, c].iter().any(|&p| self.near_small_corner(p));
         if !protected && min_angle_deg(a, b, c) < self.criteria.min_angle_deg {
-            return 3;
+            return Bad::Angle;
         }
-        if tri_circumcenter(a, b, c).is_some_and(|cc| (cc - r.centre).length() > self.criteria.distance) {
-            return 4;
+        let far = |cc: DVec3| (cc - r.centre).length() > self.criteria.distance;
+        if tri_circumcenter(a, b, c).is_some_and(far) {
+            return Bad::Distance;
         }
-        0
+        Bad::No
     }
 
     fn refine_facet(&mut self, face: [u32; 3]) {
@@ -569,21 +595,16 @@ impl<'a> SurfaceMesher<'a> {
             return;
         };
         let why = self.badness(&r);
-        if why != 0 {
-            if std::env::var("SM_DEBUG").is_ok() && self.dt.num_vertices() % 97 == 0 {
-                let pts = r.vertices.map(|v| self.dt.point(v));
-                let near = (0..self.dt.num_vertex_ids() as u32).filter(|&v| self.dt.has_vertex(v)).map(|v| (self.dt.point(v) - r.centre).length()).fold(f64::INFINITY, f64::min);
-                let tv = self.dt.tet(t); let nv = self.dt.tet(self.dt.neighbors(t)[i]);
-                eprintln!("nearest {near} tets {:?} {:?} cc {:?} {:?}", tv, nv, circumcenter_of(&self.dt, tv), circumcenter_of(&self.dt, nv));
-                eprintln!("why {why} radius {} centre {:?} verts {:?} locs {:?} pts {:?}", r.radius, r.centre, r.vertices, r.vertices.map(|v| self.loc[v as usize]), pts);
-            }
-            self.insert_surface_point(r, t);
+        if why != Bad::No {
+            self.insert_surface_point(r, t, why);
         }
     }
 
     /// Inserts a facet's surface centre, or queues the subsegments it would encroach.
-    fn insert_surface_point(&mut self, r: Restricted, hint: u32) {
-        if self.near_small_corner(r.centre) {
+    fn insert_surface_point(&mut self, r: Restricted, hint: u32, why: Bad) {
+        // Next to a small corner refinement would go on towards the apex (the curves alone
+        // are refined there, for length and distance).
+        if why != Bad::Boundary && self.near_small_corner(r.centre) {
             self.n_blocked += 1;
             return;
         }
@@ -607,7 +628,8 @@ impl<'a> SurfaceMesher<'a> {
             self.n_blocked += 1;
             return;
         };
-        self.loc.push(Loc::Patch(self.patch_of[r.triangle as usize]));
+        self.loc
+            .push(Loc::Patch(self.patch_of[r.triangle as usize]));
         debug_assert_eq!(self.loc.len(), id as usize + 1);
         self.after_insertion();
     }
@@ -677,7 +699,8 @@ impl<'a> SurfaceMesher<'a> {
             .filter(|&(t, i)| {
                 let tv = self.dt.tet(t);
                 let f = FACE[i].map(|k| tv[k]);
-                f.iter().any(|&v| v == INFINITE || self.loc[v as usize] == Loc::Far)
+                f.iter()
+                    .any(|&v| v == INFINITE || self.loc[v as usize] == Loc::Far)
                     || (0..3).any(|j| edge_count[&key2(f[j], f[(j + 1) % 3])] != 2)
             })
             .collect();
@@ -704,7 +727,11 @@ impl<'a> SurfaceMesher<'a> {
                 })
             });
             let triangle = self.facet_at(t, i).map_or_else(
-                || self.oracle.closest(centroid(&self.dt, f)).map_or(0, |c| c.triangle),
+                || {
+                    self.oracle
+                        .closest(centroid(&self.dt, f))
+                        .map_or(0, |c| c.triangle)
+                },
                 |r| r.triangle,
             );
             out.triangles.push(tri);
@@ -769,7 +796,10 @@ impl SampleGrid {
     }
 
     fn index(&self, p: DVec3) -> [i64; 3] {
-        ((p - self.origin) / self.cell).floor().as_i64vec3().to_array()
+        ((p - self.origin) / self.cell)
+            .floor()
+            .as_i64vec3()
+            .to_array()
     }
 
     fn add(&mut self, p: DVec3) {

@@ -4,7 +4,9 @@ use crate::refine::SurfaceMode;
 use std::path::Path;
 
 fn model(name: &str) -> PlcInput {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("models").join(name);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("models")
+        .join(name);
     read_plc(
         &path,
         &ReadOptions {
@@ -31,7 +33,11 @@ fn explore() {
     let t = std::time::Instant::now();
     let (mesh, report) = mesh(&input, &approximate(), None, None).unwrap();
     let q = crate::quality::measure(&mesh).unwrap();
-    println!("{name}: {} tets in {:.2}s", mesh.tets.len(), t.elapsed().as_secs_f64());
+    println!(
+        "{name}: {} tets in {:.2}s",
+        mesh.tets.len(),
+        t.elapsed().as_secs_f64()
+    );
     println!("{report:#?}");
     println!("{}", crate::quality::table(&q));
 }

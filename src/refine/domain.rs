@@ -51,6 +51,9 @@ pub struct Domain {
     pub acute_facets: FxHashSet<u32>,
     /// Per vertex: within the influence of a small input angle (see `near_acute`).
     near_small_angle: Vec<bool>,
+    /// Approximate mode only: per input segment and per input facet, the size below which a
+    /// present but encroached subsegment / subfacet is left alone (`set_small_corners`).
+    min_split_size: Option<(Vec<f64>, Vec<f64>)>,
     /// `Params::small_angle_reach`.
     small_angle_reach: f64,
     /// Protecting balls around the acute input vertices: vertex -> radius. Inside one,
@@ -77,6 +80,10 @@ pub const SMALL_ANGLE_DEG: f64 = 60.0;
 /// Protecting-ball radius as a fraction of the distance from an acute vertex to its nearest
 /// other input vertex (below one half, so that the balls of two vertices never overlap).
 pub const PROTECT_FRACTION: f64 = 0.4;
+
+/// See `Domain::set_small_corners`: boundary elements of an approximated surface below this
+/// share of their input element's size are split only when missing.
+pub const MIN_SPLIT_FRACTION: f64 = 1.0 / 16.0;
 
 /// `Domain::apex` of a vertex in no protecting ball.
 pub const NO_APEX: u32 = u32::MAX;
@@ -156,6 +163,7 @@ impl Domain {
             acute_segments: FxHashSet::default(),
             acute_facets: FxHashSet::default(),
             near_small_angle: vec![false; input.vertices.len()],
+            min_split_size: None,
             small_angle_reach: f64::INFINITY,
             dirty_segs: vec![],
             dirty_tris: vec![],
@@ -208,6 +216,48 @@ impl Domain {
         for &s in &self.acute_segments {
             self.acute_facets
                 .extend(self.segments[s as usize].facets.iter().copied());
+        }
+        self.near_small_angle = (0..self.kind.len() as u32)
+            .map(|v| self.is_near_small_angle(v, self.point(v), self.kind[v as usize]))
+            .collect();
+    }
+
+    /// The small angles of a boundary the approximate mode built: only `vertices` (its
+    /// vertices at the input's small corners) are small-angle vertices, with protecting balls;
+    /// the angles between its triangles are a remeshing's, not features.
+    ///
+    /// Its triangles are already sized to the spacing, so a boundary split far below an input
+    /// triangle's size can only be a cascade (two triangles of a curved patch whose splits
+    /// encroach each other): below [`MIN_SPLIT_FRACTION`] of its input segment or of its input
+    /// facet's shortest edge, an element is split only when missing.
+    pub fn set_small_corners(&mut self, vertices: &[u32], reach: f64) {
+        self.small_angle_reach = reach;
+        let seg_len: Vec<f64> = self
+            .segments
+            .iter()
+            .map(|s| MIN_SPLIT_FRACTION * self.point(s.ends[0]).distance(self.point(s.ends[1])))
+            .collect();
+        let mut facet_edge = vec![f64::INFINITY; self.facets.len()];
+        for s in &self.segments {
+            let l = MIN_SPLIT_FRACTION * self.point(s.ends[0]).distance(self.point(s.ends[1]));
+            for &f in &s.facets {
+                facet_edge[f as usize] = facet_edge[f as usize].min(l);
+            }
+        }
+        self.min_split_size = Some((seg_len, facet_edge));
+        for &v in vertices {
+            let r = PROTECT_FRACTION * nearest_neighbor_distance(&self.dt, v);
+            self.protect_radius.insert(v, r);
+            self.apex[v as usize] = v;
+            self.small_angle_vertices.insert(v);
+        }
+        for (f, fm) in self.facets.iter().enumerate() {
+            let apexes = &mut self.facet_apexes[f];
+            apexes.extend(
+                fm.vertices()
+                    .filter(|v| self.protect_radius.contains_key(v)),
+            );
+            apexes.sort_unstable();
         }
         self.near_small_angle = (0..self.kind.len() as u32)
             .map(|v| self.is_near_small_angle(v, self.point(v), self.kind[v as usize]))
@@ -285,6 +335,26 @@ impl Domain {
         let a = self.apex[verts[0] as usize];
         (a != NO_APEX && verts.iter().all(|&v| self.apex[v as usize] == a))
             || self.near_acute_element(verts)
+            || self.below_min_split_size(verts)
+    }
+
+    /// See `set_small_corners`.
+    fn below_min_split_size(&self, verts: &[u32]) -> bool {
+        let Some((seg_len, facet_edge)) = &self.min_split_size else {
+            return false;
+        };
+        match *verts {
+            [a, b] => self
+                .subsegs
+                .get(&seg_key(a, b))
+                .is_some_and(|&s| self.point(a).distance(self.point(b)) < seg_len[s as usize]),
+            [a, b, c] => self.subfacets.get(&tri_key([a, b, c])).is_some_and(|&f| {
+                let (pa, pb, pc) = (self.point(a), self.point(b), self.point(c));
+                let shortest = pa.distance(pb).min(pb.distance(pc)).min(pc.distance(pa));
+                shortest < facet_edge[f as usize]
+            }),
+            _ => false,
+        }
     }
 
     /// Whether a boundary element with vertices `verts` touches a feature with a small angle,

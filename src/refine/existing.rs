@@ -39,7 +39,7 @@ pub fn remove_slivers(existing: &TetMesh, params: &Params) -> Result<(TetMesh, R
         params,
         Some(&unbounded),
         None,
-        false,
+        super::SmallAngles::None,
         Unseeded::Hole,
     )
 }

@@ -383,19 +383,39 @@ pub fn mesh(
     spacing: Option<&dyn Spacing>,
     progress: Option<Progress>,
 ) -> Result<(TetMesh, Report), MeshError> {
-    mesh_domain(input, params, spacing, progress, true, Unseeded::Domain)
+    mesh_domain(
+        input,
+        params,
+        spacing,
+        progress,
+        SmallAngles::Input,
+        Unseeded::Domain,
+    )
 }
 
 /// [`mesh`] of a boundary the approximate mode built (`crate::approx`): its triangles meet at
-/// angles that are a remeshing's, not the input's, so only the angles at `small_angle_vertices`
-/// (the input's real small corners) are respected.
+/// angles that are a remeshing's, not the input's, so only the angles at `small_corners`
+/// (its vertices at the input's real small corners) are respected.
 pub(crate) fn mesh_remeshed(
     input: &PlcInput,
     params: &Params,
     spacing: Option<&dyn Spacing>,
     progress: Option<Progress>,
+    small_corners: &[u32],
 ) -> Result<(TetMesh, Report), MeshError> {
-    mesh_domain(input, params, spacing, progress, false, Unseeded::Domain)
+    let angles = SmallAngles::Only(small_corners);
+    mesh_domain(input, params, spacing, progress, angles, Unseeded::Domain)
+}
+
+/// Which input angles refinement treats as small.
+#[derive(Clone, Copy)]
+enum SmallAngles<'a> {
+    /// Those the validator finds (keep mode).
+    Input,
+    /// None (the boundary of an existing mesh).
+    None,
+    /// Only at these vertices (a boundary the approximate mode built).
+    Only(&'a [u32]),
 }
 
 /// [`mesh`], optionally treating every input angle as large (for the boundary of an existing
@@ -407,15 +427,17 @@ fn mesh_domain(
     params: &Params,
     spacing: Option<&dyn Spacing>,
     progress: Option<Progress>,
-    respect_small_angles: bool,
+    small_angles: SmallAngles,
     unseeded: Unseeded,
 ) -> Result<(TetMesh, Report), MeshError> {
     let start = std::time::Instant::now();
     params.check().map_err(MeshError::InvalidInput)?;
     let plc = crate::plc::validate(input).map_err(|e| MeshError::InvalidInput(e.to_string()))?;
     let mut dom = domain::Domain::new(input)?;
-    if respect_small_angles {
-        dom.set_acute_angles(&plc, params.small_angle_reach);
+    match small_angles {
+        SmallAngles::Input => dom.set_acute_angles(&plc, params.small_angle_reach),
+        SmallAngles::None => {}
+        SmallAngles::Only(v) => dom.set_small_corners(v, params.small_angle_reach),
     }
     let mut budget = recover::MAX_RECOVERY_SPLITS.min(params.max_vertices.saturating_mul(4));
     dom.recover_boundary(&mut budget)?;
