@@ -76,7 +76,8 @@ pub struct Corner {
     pub patches: Vec<u32>,
     /// Smallest angle between its curves or spanned by a patch, degrees.
     pub angle: f64,
-    /// Protecting-ball radius when the corner is small (`angle < SMALL_CORNER_DEG`), else 0.
+    /// Protecting-ball radius when the corner is small (`angle < SMALL_CORNER_DEG`), else 0
+    /// (it can be 0 for a small corner too, when another corner coincides with it).
     pub protect_radius: f64,
 }
 
@@ -149,7 +150,7 @@ impl FeatureCurves {
 
     /// Small corners (angle below [`SMALL_CORNER_DEG`]).
     pub fn small_corners(&self) -> impl Iterator<Item = &Corner> {
-        self.corners.iter().filter(|c| c.protect_radius > 0.0)
+        self.corners.iter().filter(|c| c.angle < SMALL_CORNER_DEG)
     }
 }
 
@@ -175,6 +176,12 @@ fn edge_patches(s: &InputSurface, f: &Features) -> FxHashMap<[u32; 2], Vec<u32>>
 fn corners(s: &InputSurface, f: &Features, curves: &[Curve]) -> Vec<Corner> {
     let mut ids: Vec<u32> = f.corners.clone();
     ids.extend(curves.iter().flat_map(|c| c.ends));
+    let cone = cone_angles(s);
+    ids.extend(
+        cone.iter()
+            .filter(|(_, &a)| a < CONE_CORNER_DEG)
+            .map(|(&v, _)| v),
+    );
     ids.sort_unstable();
     ids.dedup();
     let mut patches: FxHashMap<u32, Vec<u32>> = ids.iter().map(|&v| (v, Vec::new())).collect();
@@ -185,11 +192,16 @@ fn corners(s: &InputSurface, f: &Features, curves: &[Curve]) -> Vec<Corner> {
             }
         }
     }
-    let angle: FxHashMap<u32, f64> = f
+    let mut angle: FxHashMap<u32, f64> = f
         .corner_angles(s)
         .into_iter()
         .map(|c| (c.vertex, c.angle))
         .collect();
+    for v in &ids {
+        let a = cone.get(v).copied().unwrap_or(360.0);
+        let e = angle.entry(*v).or_insert(a);
+        *e = e.min(a);
+    }
     let points: Vec<DVec3> = ids.iter().map(|&v| s.vertices[v as usize]).collect();
     let nearest = nearest_other_distances(&points);
     ids.iter()
@@ -212,6 +224,25 @@ fn corners(s: &InputSurface, f: &Features, curves: &[Curve]) -> Vec<Corner> {
             }
         })
         .collect()
+}
+
+/// A vertex whose triangles' angles there sum to less than this is the apex of a sharp cone
+/// (a spike's tip whose edges are not sharp enough to be features): a corner, as surface
+/// refinement cannot shape the facets around it.
+const CONE_CORNER_DEG: f64 = 300.0;
+
+/// Sum of the triangle angles at every vertex.
+fn cone_angles(s: &InputSurface) -> FxHashMap<u32, f64> {
+    let mut sum: FxHashMap<u32, f64> = FxHashMap::default();
+    for tri in &s.triangles {
+        for j in 0..3 {
+            let p = s.vertices[tri[j] as usize];
+            let a = s.vertices[tri[(j + 1) % 3] as usize] - p;
+            let b = s.vertices[tri[(j + 2) % 3] as usize] - p;
+            *sum.entry(tri[j]).or_default() += a.cross(b).length().atan2(a.dot(b)).to_degrees();
+        }
+    }
+    sum
 }
 
 /// For each point, the distance to the nearest other point (infinite when alone). Sorted

@@ -30,9 +30,6 @@ fn one_sided(from: &InputSurface, to: &InputSurface, spacing: f64) -> f64 {
             }
         }
     }
-    if std::env::var("SM_DEBUG").is_ok() {
-        eprintln!("hausdorff worst {:.3e} at {:?}", worst.0, worst.1);
-    }
     worst.0
 }
 
@@ -102,9 +99,6 @@ fn feature_distance(r: &Remeshed) -> f64 {
                 .iter()
                 .map(|&(u, v)| point_segment_distance(p, u, v))
                 .fold(f64::INFINITY, f64::min);
-            if d > worst && std::env::var("SM_DEBUG").is_ok() {
-                eprintln!("feature worst {d:.3e} at {p:?} (edge {e:?})");
-            }
             worst = worst.max(d);
         }
     }

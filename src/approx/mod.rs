@@ -78,14 +78,8 @@ pub fn mesh(
     progress: Option<Progress>,
 ) -> Result<(TetMesh, Report), MeshError> {
     let start = std::time::Instant::now();
-    let remeshed = remesh(input, params, spacing)?;
-    let (mesh, mut report) = crate::refine::mesh_remeshed(
-        &remeshed.boundary,
-        params,
-        spacing,
-        progress,
-        &remeshed.small_corner_vertices,
-    )?;
+    let mut remeshed = remesh(input, params, spacing)?;
+    let (mesh, mut report) = mesh_volume(&mut remeshed, params, spacing, progress)?;
     let mesh = crate::improve::finish(mesh, &mut report, Some(&remeshed.boundary), params.improve)?;
     let mut surface_report = measure::surface_report(&remeshed, &mesh);
     if report.stop_reason.is_none() {
@@ -96,6 +90,55 @@ pub fn mesh(
     report.surface = Some(surface_report);
     report.seconds_total = start.elapsed().as_secs_f64();
     Ok((mesh, report))
+}
+
+/// Volume refinements tried at most (see [`mesh_volume`]).
+const MAX_VOLUME_ATTEMPTS: usize = 6;
+
+/// Step 4. Boundary recovery can split without end at a vertex of the new boundary where
+/// several edges meet at small angles in different planes (saddles of noisy scans): when it
+/// fails at a facet, that facet's vertices are treated as small angles too and the volume
+/// is meshed again.
+fn mesh_volume(
+    remeshed: &mut Remeshed,
+    params: &Params,
+    spacing: Option<&dyn Spacing>,
+    mut progress: Option<Progress>,
+) -> Result<(TetMesh, Report), MeshError> {
+    let mut attempt = 0;
+    let mut relay = |fraction: f64, n: usize| progress.as_mut().is_none_or(|p| p(fraction, n));
+    loop {
+        attempt += 1;
+        let result = crate::refine::mesh_remeshed(
+            &remeshed.boundary,
+            params,
+            spacing,
+            Some(&mut relay),
+            &remeshed.small_corner_vertices,
+        );
+        let failed_facet = match &result {
+            Err(MeshError::Internal(msg)) if attempt < MAX_VOLUME_ATTEMPTS => failing_facet(msg),
+            _ => None,
+        };
+        let Some(f) = failed_facet.filter(|&f| f < remeshed.boundary.facets.len()) else {
+            return result;
+        };
+        let before = remeshed.small_corner_vertices.len();
+        remeshed
+            .small_corner_vertices
+            .extend(&remeshed.boundary.facets[f].polygons[0]);
+        remeshed.small_corner_vertices.sort_unstable();
+        remeshed.small_corner_vertices.dedup();
+        if remeshed.small_corner_vertices.len() == before {
+            return result;
+        }
+    }
+}
+
+/// The facet an internal error of boundary recovery names ("facet N: ...").
+fn failing_facet(msg: &str) -> Option<usize> {
+    let rest = msg.strip_prefix("facet ")?;
+    rest.split(':').next()?.trim().parse().ok()
 }
 
 /// Steps 1-3: the new boundary.
@@ -146,93 +189,6 @@ pub fn remesh(
     };
     let mesher = SurfaceMesher::new(&surface, &oracle, &curves, &features.patch_of, f, criteria)?;
     let b = mesher.run()?;
-    if std::env::var("SM_DEBUG").is_ok() {
-        let mut angles: Vec<f64> = b
-            .triangles
-            .iter()
-            .map(|t| {
-                let [p, q, r] = t.map(|v| b.points[v as usize]);
-                restricted::min_angle_deg(p, q, r)
-            })
-            .collect();
-        angles.sort_by(f64::total_cmp);
-        eprintln!(
-            "surface: {} vertices {} triangles, blocked {}, stop {:?}, angles min {:?} p1 {:?}, below 1 deg {}, {:.2}s",
-            b.points.len(),
-            b.triangles.len(),
-            b.n_blocked,
-            b.stop_reason,
-            angles.first(),
-            angles.get(angles.len() / 100),
-            angles.iter().filter(|&&a| a < 1.0).count(),
-            start.elapsed().as_secs_f64()
-        );
-        let mut edges: rustc_hash::FxHashMap<[u32; 2], Vec<usize>> = Default::default();
-        for (k, t) in b.triangles.iter().enumerate() {
-            for j in 0..3 {
-                let (x, y) = (t[j], t[(j + 1) % 3]);
-                edges.entry([x.min(y), x.max(y)]).or_default().push(k);
-            }
-        }
-        let normal = |k: usize| {
-            let [p, q, r] = b.triangles[k].map(|v| b.points[v as usize]);
-            (q - p).cross(r - p).normalize()
-        };
-        let mut sharp: Vec<(f64, [u32; 2])> = edges
-            .iter()
-            .filter(|(_, ts)| ts.len() == 2)
-            .map(|(e, ts)| {
-                let (n1, n2) = (normal(ts[0]), normal(ts[1]));
-                (
-                    180.0 - n1.cross(n2).length().atan2(n1.dot(n2)).to_degrees(),
-                    *e,
-                )
-            })
-            .filter(|(a, _)| *a < 60.0)
-            .collect();
-        sharp.sort_by(|x, y| x.0.total_cmp(&y.0));
-        eprintln!("boundary edges with dihedral < 60: {} ", sharp.len());
-        let probe = glam::DVec3::new(
-            -0.15246885625507756,
-            -0.2981650934351484,
-            0.3930379523979265,
-        );
-        let mut near: Vec<(f64, usize)> = b
-            .points
-            .iter()
-            .enumerate()
-            .map(|(k, p)| ((*p - probe).length(), k))
-            .collect();
-        near.sort_by(|x, y| x.0.total_cmp(&y.0));
-        for &(d, k) in near.iter().take(4) {
-            let nb: Vec<u32> = edges
-                .keys()
-                .filter(|e| e[0] == k as u32 || e[1] == k as u32)
-                .map(|e| if e[0] == k as u32 { e[1] } else { e[0] })
-                .collect();
-            let mut amin = 180.0f64;
-            for i in 0..nb.len() {
-                for j in i + 1..nb.len() {
-                    let u = b.points[nb[i] as usize] - b.points[k];
-                    let w = b.points[nb[j] as usize] - b.points[k];
-                    amin = amin.min(u.cross(w).length().atan2(u.dot(w)).to_degrees());
-                }
-            }
-            eprintln!(
-                "  near: d {d:.3e} vertex {k} {:?} loc {:?} degree {} min edge angle {amin:.2}",
-                b.points[k],
-                b.loc[k],
-                nb.len()
-            );
-        }
-        for (a, e) in sharp.iter().take(5) {
-            eprintln!(
-                "  {a:.2} deg at {:?} locs {:?}",
-                b.points[e[0] as usize],
-                e.map(|v| b.loc[v as usize])
-            );
-        }
-    }
     let labels = has_labels(input);
     let facets = b
         .triangles
@@ -258,10 +214,21 @@ pub fn remesh(
         .small_corners()
         .map(|c| (c.point, c.protect_radius))
         .collect();
+    // Every vertex in a small corner's protecting ball, where the surface mesher left facet
+    // angles alone: the volume refinement protects them too (thin boundary triangles there
+    // would make it split without end).
+    //
+    // Likewise every vertex where two boundary edges meet below the facet angle bound (a
+    // saddle of a scan where non-adjacent triangles fold close): measured on elephant, such
+    // a vertex made boundary recovery split its edges at concentric shells without end.
+    let narrow = narrow_vertices(&b);
     let small_corner_vertices = (0..b.loc.len() as u32)
-        .filter(|&v| match b.loc[v as usize] {
-            restricted::Loc::Corner(k) => curves.corners[k as usize].protect_radius > 0.0,
-            _ => false,
+        .filter(|&v| {
+            let p = b.points[v as usize];
+            narrow[v as usize]
+                || curves
+                    .small_corners()
+                    .any(|c| (p - c.point).length_squared() <= c.protect_radius * c.protect_radius)
         })
         .collect();
     Ok(Remeshed {
@@ -287,4 +254,38 @@ fn has_labels(input: &PlcInput) -> bool {
         .iter()
         .enumerate()
         .all(|(i, f)| f.marker as i64 == i as i64 + 1)
+}
+
+/// Below this angle between two of its boundary edges (any two, adjacent or not) a vertex of
+/// the new boundary is treated as a small angle by the volume refinement; just below the
+/// facet angle bound, so only vertices the facet criteria could not shape are.
+const NARROW_EDGE_ANGLE_DEG: f64 = 29.0;
+
+/// Per boundary vertex: two of its edges meet below [`NARROW_EDGE_ANGLE_DEG`].
+fn narrow_vertices(b: &restricted::Boundary) -> Vec<bool> {
+    let mut neighbours: Vec<Vec<u32>> = vec![vec![]; b.points.len()];
+    for t in &b.triangles {
+        for j in 0..3 {
+            let (x, y) = (t[j], t[(j + 1) % 3]);
+            neighbours[x as usize].push(y);
+            neighbours[y as usize].push(x);
+        }
+    }
+    let cos_narrow = NARROW_EDGE_ANGLE_DEG.to_radians().cos();
+    neighbours
+        .iter_mut()
+        .enumerate()
+        .map(|(v, nb)| {
+            nb.sort_unstable();
+            nb.dedup();
+            let p = b.points[v];
+            let dirs: Vec<glam::DVec3> = nb
+                .iter()
+                .map(|&w| (b.points[w as usize] - p).normalize_or_zero())
+                .collect();
+            dirs.iter()
+                .enumerate()
+                .any(|(i, u)| dirs[i + 1..].iter().any(|w| u.dot(*w) > cos_narrow))
+        })
+        .collect()
 }

@@ -124,8 +124,6 @@ pub struct Boundary {
     pub feature_edges: Vec<[u32; 2]>,
     /// Why the mesher stopped before every facet was good, if it did.
     pub stop_reason: Option<String>,
-    /// Facets left bad because refining them would enter a small corner's protecting ball.
-    pub n_blocked: usize,
 }
 
 pub struct SurfaceMesher<'a> {
@@ -143,10 +141,21 @@ pub struct SurfaceMesher<'a> {
     facets: BinaryHeap<Queued>,
     /// Subsegments too short to split further (their ends would coincide in floating point).
     frozen: FxHashSet<[u32; 2]>,
-    n_blocked: usize,
+    /// Vertices the surface mesh may reach (`SAMPLE_BUDGET_FACTOR` x the initial samples).
+    budget: usize,
+    /// How often each facet waited for subsegment splits (see `MAX_DEFERRALS`).
+    deferrals: FxHashMap<[u32; 3], u32>,
     bad_spacing: Option<MeshError>,
     min_length: f64,
 }
+
+/// The surface mesh stops (with a reason) at this many times its initial samples: the
+/// criteria are met with a few times more in every model measured, and a facet that cannot be
+/// shaped (a configuration the criteria cannot resolve) must not refine without end.
+const SAMPLE_BUDGET_FACTOR: usize = 20;
+
+/// Rounds of subsegment splits one facet may wait for before it is left alone.
+const MAX_DEFERRALS: u32 = 8;
 
 fn key2(a: u32, b: u32) -> [u32; 2] {
     [a.min(b), a.max(b)]
@@ -191,7 +200,8 @@ impl<'a> SurfaceMesher<'a> {
             force_split: FxHashSet::default(),
             facets: BinaryHeap::new(),
             frozen: FxHashSet::default(),
-            n_blocked: 0,
+            budget: usize::MAX,
+            deferrals: FxHashMap::default(),
             bad_spacing: None,
             min_length: 1e-9 * diagonal,
         };
@@ -213,6 +223,7 @@ impl<'a> SurfaceMesher<'a> {
         let (dt, _) = Delaunay::from_points(&points)
             .map_err(|e| MeshError::InvalidInput(format!("surface samples: {e}")))?;
         m.dt = dt;
+        m.budget = SAMPLE_BUDGET_FACTOR * points.len() + 10_000;
         m.seg_queue = {
             let mut keys: Vec<[u32; 2]> = m.subsegs.keys().copied().collect();
             keys.sort_unstable();
@@ -367,24 +378,13 @@ impl<'a> SurfaceMesher<'a> {
 
     /// The refinement loop: subsegments first, then the largest bad facet.
     fn refine(&mut self) -> Option<String> {
-        let debug = std::env::var("SM_DEBUG").is_ok();
-        let mut steps = 0usize;
         loop {
-            steps += 1;
-            if debug && steps % 1000 == 0 {
-                eprintln!(
-                    "step {steps}: {} vertices, {} subsegs, seg queue {}, facet queue {}, blocked {}",
-                    self.dt.num_vertices(),
-                    self.subsegs.len(),
-                    self.seg_queue.len(),
-                    self.facets.len(),
-                    self.n_blocked
-                );
-            }
-            if self.dt.num_vertices() > self.criteria.max_vertices {
+            if self.dt.num_vertices() > self.criteria.max_vertices.min(self.budget) {
                 return Some(format!(
-                    "the surface mesh reached {} vertices (max_vertices)",
-                    self.criteria.max_vertices
+                    "the surface mesh reached {} vertices ({} from the samples, or \
+                     max_vertices): facets that refinement cannot shape",
+                    self.dt.num_vertices(),
+                    SAMPLE_BUDGET_FACTOR
                 ));
             }
             if self.bad_spacing.is_some() {
@@ -605,15 +605,20 @@ impl<'a> SurfaceMesher<'a> {
         // Next to a small corner refinement would go on towards the apex (the curves alone
         // are refined there, for length and distance).
         if why != Bad::Boundary && self.near_small_corner(r.centre) {
-            self.n_blocked += 1;
             return;
         }
         if let crate::delaunay::Probe::Duplicate(_) = self.dt.probe(r.centre, Some(hint)) {
-            self.n_blocked += 1;
             return;
         }
         let encroached = self.encroached_by_probe(r.centre);
         if !encroached.is_empty() {
+            // A centre on a feature curve encroaches its subsegments at every scale: after
+            // MAX_DEFERRALS rounds of splits the facet is left as it is.
+            let n = self.deferrals.entry(key3(r.vertices)).or_default();
+            *n += 1;
+            if *n > MAX_DEFERRALS {
+                return;
+            }
             for k in encroached {
                 self.force_split.insert(k);
                 self.seg_queue.push(k);
@@ -625,7 +630,6 @@ impl<'a> SurfaceMesher<'a> {
             return;
         }
         let Ok(Inserted::New(id)) = self.dt.insert(r.centre, Some(hint)) else {
-            self.n_blocked += 1;
             return;
         };
         self.loc
@@ -711,7 +715,6 @@ impl<'a> SurfaceMesher<'a> {
     fn boundary(&self, faces: Vec<(u32, usize)>, stop_reason: Option<String>) -> Boundary {
         let mut out = Boundary {
             stop_reason,
-            n_blocked: self.n_blocked,
             ..Boundary::default()
         };
         let mut new_id: FxHashMap<u32, u32> = FxHashMap::default();

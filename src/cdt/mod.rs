@@ -538,14 +538,6 @@ impl FacetMesh {
         }
         let (t, i) = self.facet_edge(a, b).ok_or(SplitError::NotAnEdge(a, b))?;
         if !self.split_keeps_orientation(t, i, p) {
-            if std::env::var("SM_DEBUG").is_ok() {
-                let tr = self.tris[t as usize];
-                let u = tr.n[i] / 3;
-                let ur = self.tris[u as usize];
-                let j = (tr.n[i] % 3) as usize;
-                let (c, x, y, d) = (tr.v[i], tr.v[nx(i)], tr.v[pv(i)], ur.v[j]);
-                eprintln!("split {a} {b} at {:?} ({:?}) : c {:?} x {:?} y {:?} d {:?}; inside {} {}; nverts {}", p, self.proj(p), self.p2[c as usize], self.p2[x as usize], self.p2[y as usize], self.p2[d as usize], tr.inside(), ur.inside(), self.p2.len());
-            }
             return Err(SplitError::WouldInvert);
         }
         let tr = self.tris[t as usize];
