@@ -334,19 +334,10 @@ fn refine_dispatches_on_the_surface_mode() {
     assert!(report.surface.is_none(), "keep mode has no surface report");
 
     m.set_param("surface_mode", 1.0).unwrap();
-    match m.refine() {
-        Ok(report) => {
-            // TODO(approx): require Ok once approx::mesh lands.
-            assert!(report.n_tets > 0);
-            assert!(
-                report.surface.is_some(),
-                "approximate mode reports its surface"
-            );
-        }
-        Err(e) => {
-            let e = e.to_string();
-            assert!(e.contains("approximate"), "{e}");
-            assert!(m.output().is_none());
-        }
-    }
+    let report = m.refine().unwrap();
+    assert!(report.n_tets > 0);
+    assert!(
+        report.surface.is_some(),
+        "approximate mode reports its surface"
+    );
 }
