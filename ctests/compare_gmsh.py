@@ -307,7 +307,11 @@ def compare(args, outdir):
 
     failures = []
     if not ours.get("complete"):
-        failures.append("%s: slivermesh did not complete: %s" % (name, ours.get("stop_reason")))
+        msg = "%s: slivermesh did not complete: %s" % (name, ours.get("stop_reason"))
+        if args.allow_incomplete:
+            print("note: " + msg)
+        else:
+            failures.append(msg)
     if ours_m["n_inverted"] or ours_m["n_zero_volume"]:
         failures.append("%s: slivermesh mesh has %d inverted and %d zero-volume tets"
                         % (name, ours_m["n_inverted"], ours_m["n_zero_volume"]))
@@ -356,6 +360,9 @@ def main():
     size = ap.add_mutually_exclusive_group(required=True)
     size.add_argument("--size", type=float, help="slivermesh's --size (fixed)")
     size.add_argument("--tets", type=int, help="instead of --size: adjust slivermesh's --size to about this many tets")
+    ap.add_argument("--allow-incomplete", action="store_true",
+                    help="report an incomplete slivermesh run (a bound missed by a few tets) "
+                         "instead of failing; the angle, validity and volume checks still apply")
     ap.add_argument("--slivermesh-args", default="--surface approximate",
                     help="extra arguments for `slivermesh mesh`, one shell-quoted string "
                          "(default '--surface approximate'; '' for the keep mode); write it "

@@ -198,7 +198,11 @@ def compare_model(args, model, outdir):
 
     failures = []
     if not ours.get("complete"):
-        failures.append("%s: slivermesh did not complete: %s" % (name, ours.get("stop_reason")))
+        msg = "%s: slivermesh did not complete: %s" % (name, ours.get("stop_reason"))
+        if args.allow_incomplete:
+            print("note: " + msg)
+        else:
+            failures.append(msg)
     ratio = ours["n_tets"] / cgal["n_tets"]
     if abs(ratio - 1.0) > args.count_tol:
         failures.append("%s: tet counts not comparable: slivermesh %d, CGAL %d (ratio %.3f, allowed +-%.0f%%)"
@@ -248,6 +252,9 @@ def main():
     ap.add_argument("--max-runs", type=int, default=6, help="calibration runs per program (default 6)")
     ap.add_argument("--slivermesh-arg", action="append", default=[],
                     help="extra argument for `slivermesh mesh` (repeatable), e.g. --slivermesh-arg=--min-dihedral=20")
+    ap.add_argument("--allow-incomplete", action="store_true",
+                    help="report an incomplete slivermesh run (a bound missed by a few tets) "
+                         "instead of failing; the angle, validity and volume checks still apply")
     ap.add_argument("--slivermesh-args", default="",
                     help="extra arguments for `slivermesh mesh` as one shell-quoted string, e.g. "
                          "--slivermesh-args='--surface approximate' (default none)")
