@@ -77,6 +77,9 @@ struct Restricted {
     triangle: u32,
 }
 
+/// A face of the triangulation: a tet and the local index of the vertex opposite the face.
+type FaceRef = (u32, usize);
+
 /// Why a restricted facet is refined.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Bad {
@@ -394,9 +397,8 @@ impl<'a> SurfaceMesher<'a> {
                 self.check_subseg(k);
                 continue;
             }
-            let Some(q) = self.facets.pop() else {
-                return None;
-            };
+            // Both queues empty: done, no stop reason.
+            let q = self.facets.pop()?;
             self.refine_facet(q.face);
         }
     }
@@ -670,7 +672,7 @@ impl<'a> SurfaceMesher<'a> {
     /// The faces between tets whose circumcentres are inside and outside the surface (as
     /// (inside tet, face index)), and those of them that break the boundary: a vertex off the
     /// surface, or an edge not shared by exactly two faces.
-    fn extract(&self) -> (Vec<(u32, usize)>, Vec<(u32, usize)>) {
+    fn extract(&self) -> (Vec<FaceRef>, Vec<FaceRef>) {
         let cap = self.dt.tet_capacity();
         let mut inside = vec![false; cap];
         for t in self.dt.finite_tet_ids() {
@@ -712,7 +714,7 @@ impl<'a> SurfaceMesher<'a> {
     }
 
     /// The boundary from the extracted faces, oriented outwards, vertices renumbered.
-    fn boundary(&self, faces: Vec<(u32, usize)>, stop_reason: Option<String>) -> Boundary {
+    fn boundary(&self, faces: Vec<FaceRef>, stop_reason: Option<String>) -> Boundary {
         let mut out = Boundary {
             stop_reason,
             ..Boundary::default()
