@@ -181,14 +181,7 @@ impl Domain {
             self.protect_radius.insert(v, r);
             self.apex[v as usize] = v;
         }
-        for (f, fm) in self.facets.iter().enumerate() {
-            let apexes = &mut self.facet_apexes[f];
-            apexes.extend(
-                fm.vertices()
-                    .filter(|v| self.protect_radius.contains_key(v)),
-            );
-            apexes.sort_unstable();
-        }
+        self.record_facet_apexes();
         let acute = plc.acute_angles();
         for a in acute
             .segment_angles
@@ -217,9 +210,7 @@ impl Domain {
             self.acute_facets
                 .extend(self.segments[s as usize].facets.iter().copied());
         }
-        self.near_small_angle = (0..self.kind.len() as u32)
-            .map(|v| self.is_near_small_angle(v, self.point(v), self.kind[v as usize]))
-            .collect();
+        self.mark_near_small_angles();
     }
 
     /// The small angles of a boundary the approximate mode built: only `vertices` (its
@@ -251,6 +242,12 @@ impl Domain {
             self.apex[v as usize] = v;
             self.small_angle_vertices.insert(v);
         }
+        self.record_facet_apexes();
+        self.mark_near_small_angles();
+    }
+
+    /// Lists, per facet, its vertices with a protecting ball.
+    fn record_facet_apexes(&mut self) {
         for (f, fm) in self.facets.iter().enumerate() {
             let apexes = &mut self.facet_apexes[f];
             apexes.extend(
@@ -259,6 +256,10 @@ impl Domain {
             );
             apexes.sort_unstable();
         }
+    }
+
+    /// Computes `near_acute` for every vertex present.
+    fn mark_near_small_angles(&mut self) {
         self.near_small_angle = (0..self.kind.len() as u32)
             .map(|v| self.is_near_small_angle(v, self.point(v), self.kind[v as usize]))
             .collect();
