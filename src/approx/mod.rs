@@ -80,7 +80,7 @@ pub fn mesh(
     let start = std::time::Instant::now();
     let mut remeshed = remesh(input, params, spacing)?;
     let (mesh, mut report) = mesh_volume(&mut remeshed, params, spacing, progress)?;
-    let mesh = crate::improve::finish(mesh, &mut report, Some(&remeshed.boundary), params.improve)?;
+    let mesh = crate::improve::finish(mesh, &mut report, Some(&remeshed.boundary), params)?;
     let mut surface_report = measure::surface_report(&remeshed, &mesh);
     if report.stop_reason.is_none() {
         report.stop_reason = remeshed.stop_reason.clone();

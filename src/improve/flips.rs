@@ -8,7 +8,7 @@
 //! Positive orientation of all new tets is sufficient: they have the same outer faces as the
 //! old ones, so (a degree argument) they tile the same polyhedron.
 
-use super::quality::min_sin;
+use super::quality::objective;
 use super::topo::{edge_key, key3, Work, DEAD};
 use super::Improver;
 
@@ -55,7 +55,7 @@ impl Improver {
     /// only made for tets that could help).
     fn candidate(&self, t: [u32; 4], floor: f64) -> f64 {
         let [a, b, c, d] = self.w.points(&t);
-        let q = min_sin(a, b, c, d);
+        let q = objective(a, b, c, d, self.w.rho_weight);
         if q <= floor || !self.w.positive(t) {
             return f64::NEG_INFINITY;
         }

@@ -2,7 +2,8 @@
 //! improvement", IMR 2007): on the final [`TetMesh`], with no knowledge of how it was made.
 //!
 //! - `quality`: the objective, the smallest sine of the dihedral angles (small for angles near
-//!   0 and near 180 degrees alike);
+//!   0 and near 180 degrees alike), capped so that a radius-edge ratio over the bound scores
+//!   as badly as an angle under the target;
 //! - `topo`: the working mesh (tet slots, vertex stars, boundary triangles, edge rings);
 //! - `constraints`: how each vertex may move (input vertices never, segment vertices along the
 //!   segment, facet vertices in the facet's plane), and the flat facet patches;
@@ -43,6 +44,9 @@ pub struct Options {
     pub target_deg: f64,
     /// Passes at most over the bad tets.
     pub max_passes: usize,
+    /// Radius-edge ratio above which a tet counts as bad like one below the target angle
+    /// (`quality::objective`); infinite: angles only.
+    pub max_rho: f64,
 }
 
 impl Default for Options {
@@ -51,6 +55,7 @@ impl Default for Options {
             improve: true,
             target_deg: 26.0,
             max_passes: 4,
+            max_rho: 2.0,
         }
     }
 }
@@ -109,7 +114,8 @@ fn key(q: f64) -> u64 {
 /// without it (an existing mesh) the boundary stays as it is.
 pub fn improve(mesh: &TetMesh, input: Option<&PlcInput>, opts: &Options) -> (TetMesh, Stats) {
     let start = std::time::Instant::now();
-    let mut w = Work::new(mesh);
+    let rho_weight = opts.target_deg.to_radians().sin() * opts.max_rho;
+    let mut w = Work::new(mesh, rho_weight);
     let (cons, normals) = constraints::classify(&mut w, input);
     let mut im = Improver {
         w,
@@ -293,17 +299,18 @@ pub fn update_report(report: &mut Report, mesh: &TetMesh) {
     }
 }
 
-/// The step every mesher output goes through: improvement (or, with `improve` false, only
-/// the removal of flat and inverted tets), the check that no tet is degenerate, and the
+/// The step every mesher output goes through: improvement (or, with `params.improve` false,
+/// only the removal of flat and inverted tets; tets over `params.rho0` count as bad), the check that no tet is degenerate, and the
 /// report's shape figures re-measured when the mesh changed.
 pub fn finish(
     mesh: TetMesh,
     report: &mut Report,
     input: Option<&PlcInput>,
-    improve_on: bool,
+    params: &crate::refine::Params,
 ) -> Result<TetMesh, MeshError> {
     let opts = Options {
-        improve: improve_on,
+        improve: params.improve,
+        max_rho: params.rho0,
         ..Options::default()
     };
     let before = (report.min_dihedral_deg, report.max_dihedral_deg);

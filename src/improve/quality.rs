@@ -39,6 +39,31 @@ pub fn min_sin(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
     }
 }
 
+/// The improver's objective: [`min_sin`], capped by `rho_weight / rho` (rho the radius-edge
+/// ratio, circumradius over shortest edge). With `rho_weight = sin(target) * max_rho` a tet
+/// whose rho exceeds `max_rho` scores below the target like one with a small angle: it is
+/// worked on, and no change trades angles for a short edge under a large circumsphere.
+/// `rho_weight = inf` leaves [`min_sin`] alone.
+#[inline]
+pub fn objective(a: DVec3, b: DVec3, c: DVec3, d: DVec3, rho_weight: f64) -> f64 {
+    let s = min_sin(a, b, c, d);
+    if s <= 0.0 || rho_weight == f64::INFINITY {
+        return s;
+    }
+    let (u, v, w) = (b - a, c - a, d - a);
+    let det = u.dot(v.cross(w));
+    let l2 = crate::geom::measures::edge_lengths_sq(u, v, w);
+    // 2 R det = |num|, so 1 / rho = shortest * 2 det / |num|.
+    let num = v.cross(w) * l2[0] + w.cross(u) * l2[1] + u.cross(v) * l2[2];
+    let shortest = l2.iter().copied().fold(f64::INFINITY, f64::min).sqrt();
+    let inv_rho = 2.0 * det * shortest / num.length();
+    if inv_rho.is_finite() {
+        s.min(rho_weight * inv_rho)
+    } else {
+        s
+    }
+}
+
 /// The angle in degrees whose sine is `s` (for reporting thresholds).
 pub fn sin_to_deg(s: f64) -> f64 {
     s.clamp(-1.0, 1.0).asin().to_degrees()
@@ -92,6 +117,31 @@ mod tests {
             let p = p.abs();
             assert!((p - q).abs() < 1e-9, "{p} vs {q}");
         }
+    }
+
+    #[test]
+    fn objective_caps_by_radius_edge_ratio() {
+        let (a, b, c, d) = (DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z);
+        let rho = crate::geom::radius_edge_ratio(a, b, c, d);
+        assert_eq!(objective(a, b, c, d, f64::INFINITY), min_sin(a, b, c, d));
+        let capped = objective(a, b, c, d, 0.1);
+        assert!(
+            (capped - 0.1 / rho).abs() < 1e-12,
+            "{capped} vs {}",
+            0.1 / rho
+        );
+        // A tet with good angles but a short edge under a large sphere: the cap binds.
+        let e = DVec3::new(0.05, 0.0, 0.0);
+        let (p, q, r, s) = (
+            DVec3::ZERO,
+            e,
+            DVec3::new(0.02, 1.0, 0.0),
+            DVec3::new(0.03, 0.5, 0.9),
+        );
+        let rho = crate::geom::radius_edge_ratio(p, q, r, s);
+        let o = objective(p, q, r, s, 0.5);
+        assert!((o - (0.5 / rho).min(min_sin(p, q, r, s))).abs() < 1e-12);
+        assert_eq!(objective(b, a, c, d, 0.5), min_sin(b, a, c, d));
     }
 
     #[test]

@@ -10,7 +10,7 @@
 
 use super::constraints::{on_hull, Constraint};
 use super::flips::MIN_GAIN;
-use super::quality::min_sin;
+use super::quality::objective;
 use super::topo::DEAD;
 use super::Improver;
 use glam::DVec3;
@@ -24,9 +24,9 @@ const ACTIVE: f64 = 1e-3;
 
 /// The objective of star tet `t` (vertex ids) with vertex `v` at `x`.
 #[inline]
-fn q_at(pos: &[DVec3], t: &[u32; 4], v: u32, x: DVec3) -> f64 {
+fn q_at(pos: &[DVec3], rho_weight: f64, t: &[u32; 4], v: u32, x: DVec3) -> f64 {
     let p = t.map(|u| if u == v { x } else { pos[u as usize] });
-    min_sin(p[0], p[1], p[2], p[3])
+    objective(p[0], p[1], p[2], p[3], rho_weight)
 }
 
 /// The point of least norm in the convex hull of `g` (Frank-Wolfe; exact for two points).
@@ -62,7 +62,7 @@ impl Improver {
     /// Worst objective of v's star with v at x.
     fn star_min(&self, star: &[[u32; 4]], v: u32, x: DVec3) -> f64 {
         star.iter()
-            .map(|t| q_at(&self.w.pos, t, v, x))
+            .map(|t| q_at(&self.w.pos, self.w.rho_weight, t, v, x))
             .fold(f64::INFINITY, f64::min)
     }
 
@@ -123,7 +123,10 @@ impl Improver {
 
         let h = 1e-7 * scale;
         for _ in 0..MAX_STEPS {
-            let qs: Vec<f64> = star.iter().map(|t| q_at(&self.w.pos, t, v, x)).collect();
+            let qs: Vec<f64> = star
+                .iter()
+                .map(|t| q_at(&self.w.pos, self.w.rho_weight, t, v, x))
+                .collect();
             let worst = qs.iter().copied().fold(f64::INFINITY, f64::min);
             let mut grads = vec![];
             for (t, &q) in star.iter().zip(&qs) {
@@ -131,9 +134,9 @@ impl Improver {
                     continue;
                 }
                 let g = DVec3::new(
-                    q_at(&self.w.pos, t, v, x + DVec3::X * h) - q,
-                    q_at(&self.w.pos, t, v, x + DVec3::Y * h) - q,
-                    q_at(&self.w.pos, t, v, x + DVec3::Z * h) - q,
+                    q_at(&self.w.pos, self.w.rho_weight, t, v, x + DVec3::X * h) - q,
+                    q_at(&self.w.pos, self.w.rho_weight, t, v, x + DVec3::Y * h) - q,
+                    q_at(&self.w.pos, self.w.rho_weight, t, v, x + DVec3::Z * h) - q,
                 ) / h;
                 grads.push(cons.project(g));
             }
@@ -166,7 +169,7 @@ impl Improver {
         }
         self.w.pos[v as usize] = x;
         for (&t, tv) in ids.iter().zip(&star) {
-            self.w.q[t as usize] = q_at(&self.w.pos, tv, v, x);
+            self.w.q[t as usize] = q_at(&self.w.pos, self.w.rho_weight, tv, v, x);
         }
         self.stats.smoothed += 1;
         true

@@ -254,7 +254,11 @@ fn flat_tet_on_a_facet_is_flipped_away() {
     assert!(check_no_degenerate(&mesh).is_err());
     for improve_on in [false, true] {
         let mut report = Report::default();
-        let out = finish(mesh.clone(), &mut report, Some(&input), improve_on).unwrap();
+        let params = crate::refine::Params {
+            improve: improve_on,
+            ..Default::default()
+        };
+        let out = finish(mesh.clone(), &mut report, Some(&input), &params).unwrap();
         assert_eq!(out.tets.len(), 2, "{:?}", report.improvement);
         assert_eq!(report.improvement.boundary_flips, 1);
         assert!(!report.delaunay);
@@ -279,7 +283,7 @@ fn flat_tet_on_a_facet_is_flipped_away() {
     // Without the input description the boundary may not flip; here the interior 3-2 flip
     // of edge 1-3 removes the flat tet instead, keeping the base's triangles.
     let mut report = Report::default();
-    let out = finish(mesh.clone(), &mut report, None, true).unwrap();
+    let out = finish(mesh.clone(), &mut report, None, &Default::default()).unwrap();
     assert_eq!(out.boundary, mesh.boundary);
     assert_eq!(report.improvement.edge_removals, 1);
     assert_eq!(out.tets.len(), 2);
@@ -302,12 +306,15 @@ fn two_three_flip() {
             t.swap(0, 1);
         }
     }
-    let w = Work::new(&TetMesh {
-        vertices,
-        tets,
-        tet_regions: vec![0, 0],
-        ..Default::default()
-    });
+    let w = Work::new(
+        &TetMesh {
+            vertices,
+            tets,
+            tet_regions: vec![0, 0],
+            ..Default::default()
+        },
+        f64::INFINITY,
+    );
     let im = Improver {
         w,
         cons: vec![Constraint::Fixed; 5],

@@ -1,7 +1,7 @@
 //! The improver's working mesh: tets in slots (a free list keeps ids stable and reuse
 //! deterministic), vertex stars, boundary triangles by sorted key, and the rings around edges.
 
-use super::quality::min_sin;
+use super::quality::objective;
 use crate::geom::orient3d;
 use crate::mesh::TetMesh;
 use glam::DVec3;
@@ -36,8 +36,10 @@ pub(crate) struct Work {
     /// Boundary edges (sorted pair, smaller id high) inside one facet patch: the only ones a
     /// boundary flip may remove.
     pub flat_edges: FxHashSet<u64>,
-    /// Objective (`quality::min_sin`) of every tet slot.
+    /// Objective (`quality::objective`) of every tet slot.
     pub q: Vec<f64>,
+    /// The objective's radius-edge weight.
+    pub rho_weight: f64,
 }
 
 /// The key of edge (a, b) in `Work::flat_edges`.
@@ -69,7 +71,7 @@ pub(crate) fn even_perm(t: &[u32; 4], p: [u32; 4]) -> bool {
 }
 
 impl Work {
-    pub fn new(mesh: &TetMesh) -> Work {
+    pub fn new(mesh: &TetMesh, rho_weight: f64) -> Work {
         let n = mesh.vertices.len();
         let mut w = Work {
             pos: mesh.vertices.clone(),
@@ -85,6 +87,7 @@ impl Work {
             bstar: vec![Vec::new(); n],
             flat_edges: FxHashSet::default(),
             q: Vec::with_capacity(mesh.tets.len()),
+            rho_weight,
         };
         let mut degree = vec![0u32; n];
         mesh.tets
@@ -117,7 +120,7 @@ impl Work {
 
     pub fn add_tet(&mut self, t: [u32; 4], region: i32) -> u32 {
         let [a, b, c, d] = self.points(&t);
-        let q = min_sin(a, b, c, d);
+        let q = objective(a, b, c, d, self.rho_weight);
         let id = match self.free.pop() {
             Some(id) => {
                 self.tets[id as usize] = t;
