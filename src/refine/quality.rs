@@ -14,7 +14,7 @@ use crate::geom::screen::{
     longest_edge_direct as longest_edge, shortest_edge_sq, sliver_measures, SliverScreen,
 };
 use crate::geom::{
-    circum_offset_crossed, circumsphere, diametric_ball, equatorial_ball, orient3d,
+    circum_offset_crossed, circumsphere, diametric_ball, equatorial_ball, insphere, orient3d,
     tri_circumcenter,
 };
 use glam::DVec3;
@@ -298,6 +298,17 @@ impl<'a> Refiner<'a> {
             self.gave_up += 1;
             return Ok(());
         };
+        if insphere(a, b, c, d, centre) <= 0.0 {
+            // The computed centre is not inside the tet's own circumsphere (exact test): the
+            // tet is flat to rounding (four nearly cocircular points, seen on coplanar
+            // boundary triangles of separate facets) and its float circumsphere is noise. A
+            // point there would not remove the tet, and it would be drawn again without end;
+            // only restoring the boundary around it can help.
+            if !self.resettle_near(bad.tet)? {
+                self.gave_up += 1;
+            }
+            return Ok(());
+        }
         let centroid = (a + b + c + d) * 0.25;
         let le = longest_edge(a, b, c, d);
         if !self.domain_box.contains(centre) && centre.distance(centroid) > FAR_CENTRE_PER_EDGE * le
