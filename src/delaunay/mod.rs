@@ -350,6 +350,31 @@ impl Delaunay {
         self.search_star(a, &mut Vec::with_capacity(64), |v| v.contains(&b))
     }
 
+    /// The tets around edge ab (hull tets included), in rotation order, into `ring`; false
+    /// (and `ring` empty) when ab is not an edge. A walk across the faces holding ab: as many
+    /// steps as tets around the edge, where collecting them from a's star visits all of it.
+    pub fn edge_ring(&self, a: u32, b: u32, ring: &mut Vec<u32>) -> bool {
+        ring.clear();
+        let Some(start) = self.find_edge(a, b) else {
+            return false;
+        };
+        let (mut t, mut prev) = (start, u32::MAX);
+        loop {
+            ring.push(t);
+            let Tet { v, n } = *self.tet_ref(t);
+            // The two faces holding ab are those opposite the other two vertices.
+            let next = (0..4)
+                .filter(|&i| v[i] != a && v[i] != b)
+                .map(|i| n[i] >> 2)
+                .find(|&m| m != prev)
+                .unwrap_or(prev);
+            (prev, t) = (t, next);
+            if t == start || ring.len() > self.tets.len() {
+                return true;
+            }
+        }
+    }
+
     /// The tets (one or two) having face abc, with the local index of their fourth vertex.
     pub fn find_face(&self, a: u32, b: u32, c: u32) -> Option<[(u32, usize); 2]> {
         let t = self.search_star(a, &mut Vec::with_capacity(64), |v| {

@@ -401,3 +401,38 @@ fn vertex_star_of_a_high_degree_vertex() {
         assert!(dt.tet(t).contains(&c) && dt.tet(t).contains(&v));
     }
 }
+
+#[test]
+fn edge_ring_is_every_tet_holding_the_edge() {
+    // Interior and hull edges of a point cloud with a grid part (cospherical ties).
+    let mut pts = sphere(200, 3);
+    for i in 0..3 {
+        for j in 0..3 {
+            for k in 0..3 {
+                pts.push(DVec3::new(i as f64, j as f64, k as f64) * 0.2);
+            }
+        }
+    }
+    let (dt, _) = Delaunay::from_points(&pts).unwrap();
+    let mut ring = vec![];
+    let mut edges = 0;
+    for a in 0..pts.len() as u32 {
+        for b in a + 1..pts.len() as u32 {
+            let mut expected: Vec<u32> = (0..dt.tet_capacity() as u32)
+                .filter(|&t| dt.is_alive(t) && dt.tet(t).contains(&a) && dt.tet(t).contains(&b))
+                .collect();
+            let found = dt.edge_ring(a, b, &mut ring);
+            assert_eq!(found, !expected.is_empty(), "edge {a} {b}");
+            // Consecutive ring tets share a face.
+            for (i, &t) in ring.iter().enumerate() {
+                let u = ring[(i + 1) % ring.len()];
+                assert!(dt.neighbors(t).contains(&u));
+            }
+            ring.sort_unstable();
+            expected.sort_unstable();
+            assert_eq!(ring, expected, "edge {a} {b}");
+            edges += found as usize;
+        }
+    }
+    assert!(edges > 500, "{edges}");
+}

@@ -101,16 +101,14 @@ impl Domain {
     /// around it lies strictly inside its diametric ball (for a Delaunay edge, a vertex in the
     /// ball implies one among the edge's link).
     fn subsegment_status(&self, a: u32, b: u32) -> Status {
-        let Some(_) = self.dt.find_edge(a, b) else {
+        let mut ring = Vec::with_capacity(16);
+        if !self.dt.edge_ring(a, b, &mut ring) {
             return Status::Missing;
-        };
+        }
         let (c, r) = diametric_ball(self.point(a), self.point(b));
         let r2 = r * r;
-        for t in self.dt.vertex_star(a) {
+        for t in ring {
             let v = self.dt.tet(t);
-            if !v.contains(&b) {
-                continue;
-            }
             for &w in &v {
                 if w != a && w != b && w != INFINITE && self.point(w).distance_squared(c) < r2 {
                     return self.encroached_unless_protected(&[a, b]);
