@@ -319,7 +319,9 @@ sm_status sm_add_region(sm_mesher *m,
  * within surface_distance of it), "feature_angle" (approximate mode: degrees in (0, 180),
  * default 40; an edge whose two triangles' normals differ by more is a sharp feature),
  * "surface_distance" (approximate mode: finite, >= 0, absolute length; 0, the default, means
- * 0.001 x the input's bounding-box diagonal).
+ * 0.001 x the input's bounding-box diagonal), "improve_target" (degrees in [0, 40]:
+ * improvement works on tets with a smaller dihedral angle; 0, the default, means 26 in keep
+ * mode and 20 in approximate mode).
  * An unknown name or out-of-range value gives `SM_ERR_INVALID_ARGUMENT`; `sm_last_error`
  * says why (and lists the valid names).
  *

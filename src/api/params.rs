@@ -24,6 +24,7 @@ pub const PARAM_NAMES: &[&str] = &[
     "surface_mode",
     "feature_angle",
     "surface_distance",
+    "improve_target",
 ];
 
 /// Smallest accepted `rho0` (the refiner's own limit, `Params::check`).
@@ -46,7 +47,8 @@ const MAX_EXACT_INT: f64 = 9_007_199_254_740_992.0; // 2^53
 /// (0 or 1), `surface_mode` (0 = keep the input facets, 1 = approximate the surface they
 /// describe), `feature_angle` (degrees, in (0, 180): approximate mode's sharp-edge threshold),
 /// `surface_distance` (finite, >= 0: approximate mode's distance bound; 0 = the default, 0.001 x
-/// the bounding-box diagonal). Integer and 0/1 parameters must be given as whole numbers.
+/// the bounding-box diagonal), `improve_target` (degrees in [0, 40]: improvement works on tets
+/// with a smaller dihedral angle; 0 = the mode's default, 26 keep / 20 approximate). Integer and 0/1 parameters must be given as whole numbers.
 /// The result also passes `Params::check` (the refiner's own validation), so a value accepted
 /// here is never refused by `refine`.
 pub fn set_param(params: &mut Params, name: &str, value: f64) -> Result<(), Error> {
@@ -166,6 +168,16 @@ fn set_unchecked(params: &mut Params, name: &str, value: f64) -> Result<(), Erro
             }
             params.surface_distance = value;
         }
+        "improve_target" => {
+            if !(value.is_finite() && (0.0..=crate::refine::MAX_IMPROVE_TARGET).contains(&value)) {
+                return invalid(format!(
+                    "improve_target = {value} is out of range [0, 40] degrees: improvement works \
+                     on tets with a smaller dihedral angle (0 = the mode's default, 26 keep / \
+                     20 approximate)"
+                ));
+            }
+            params.improve_target = value;
+        }
         "refine" => {
             params.refine = match value {
                 0.0 => false,
@@ -209,6 +221,7 @@ pub fn get_param(params: &Params, name: &str) -> Result<f64, Error> {
         },
         "feature_angle" => params.feature_angle,
         "surface_distance" => params.surface_distance,
+        "improve_target" => params.improve_target,
         _ => {
             return invalid(format!(
                 "unknown parameter \"{name}\"; valid names: {}",
@@ -280,6 +293,7 @@ mod tests {
             ("surface_mode", 1.0),
             ("feature_angle", 30.0),
             ("surface_distance", 0.01),
+            ("improve_target", 30.0),
         ];
         assert_eq!(values.len(), PARAM_NAMES.len());
         for (name, v) in values {

@@ -261,6 +261,9 @@ fn surface_parameters_by_name() {
             &["feature_angle", "(0, 180)"][..],
         ),
         ("feature_angle", f64::NAN, &["feature_angle", "NaN"][..]),
+        ("improve_target", 41.0, &["improve_target", "[0, 40]"][..]),
+        ("improve_target", -1.0, &["improve_target", "[0, 40]"][..]),
+        ("improve_target", f64::NAN, &["improve_target", "NaN"][..]),
         (
             "surface_distance",
             -1.0,
@@ -340,4 +343,15 @@ fn refine_dispatches_on_the_surface_mode() {
         report.surface.is_some(),
         "approximate mode reports its surface"
     );
+}
+
+#[test]
+fn improve_target_defaults_by_surface_mode() {
+    use crate::refine::{APPROXIMATE_IMPROVE_TARGET, KEEP_IMPROVE_TARGET};
+    let mut p = Params::default();
+    assert_eq!(p.effective_improve_target(), KEEP_IMPROVE_TARGET);
+    p.surface_mode = SurfaceMode::Approximate;
+    assert_eq!(p.effective_improve_target(), APPROXIMATE_IMPROVE_TARGET);
+    p.improve_target = 30.0;
+    assert_eq!(p.effective_improve_target(), 30.0);
 }

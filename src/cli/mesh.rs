@@ -51,6 +51,10 @@ pub struct MeshOptions {
     /// inverted tets are still removed; the report says whether the output is Delaunay).
     #[arg(long)]
     pub no_improve: bool,
+    /// Improvement works on tets whose smallest dihedral angle is below DEG degrees (in
+    /// (0, 40]; default 26 in keep mode, 20 in approximate mode).
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
+    pub improve_target: Option<f64>,
     /// keep: every input facet is preserved exactly; approximate: the input triangles describe
     /// a piecewise smooth surface, its sharp features are kept and the boundary is a new
     /// triangulation within --surface-distance of it. Default: approximate for .off, .stl,
@@ -106,6 +110,9 @@ impl MeshOptions {
         };
         if let Some(v) = self.feature_angle {
             p.feature_angle = v;
+        }
+        if let Some(v) = self.improve_target {
+            p.improve_target = v;
         }
         if let Some(v) = self.surface_distance {
             p.surface_distance = v;

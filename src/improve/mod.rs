@@ -311,6 +311,7 @@ pub fn finish(
     let opts = Options {
         improve: params.improve,
         max_rho: params.rho0,
+        target_deg: params.effective_improve_target(),
         ..Options::default()
     };
     let before = (report.min_dihedral_deg, report.max_dihedral_deg);
