@@ -22,15 +22,13 @@ const MIN_PIECES: usize = 3;
 /// Largest distance from samples of `from` to `to`.
 fn one_sided(from: &InputSurface, to: &InputSurface, spacing: f64) -> f64 {
     let oracle = SurfaceOracle::new(to);
-    let mut worst = (0.0, DVec3::ZERO);
+    let mut worst: f64 = 0.0;
     for p in samples_per_edge_at_least(from, spacing, MIN_PIECES) {
-        if let Some(c) = oracle.closest(p) {
-            if c.distance > worst.0 {
-                worst = (c.distance, p);
-            }
+        if let Some(d) = oracle.distance_beyond(p, worst) {
+            worst = worst.max(d);
         }
     }
-    worst.0
+    worst
 }
 
 /// Points per input feature edge where its distance to the output's feature edges is taken.

@@ -184,6 +184,38 @@ impl<'a> SurfaceOracle<'a> {
         best
     }
 
+    /// The distance from `p` to the surface when it exceeds `r`, else None. Stops at the first
+    /// triangle within `r`: a sampled Hausdorff distance only needs the samples that raise the
+    /// running maximum, and most samples lie close to the other surface.
+    pub fn distance_beyond(&self, p: DVec3, r: f64) -> Option<f64> {
+        let mut stack = vec![0usize];
+        while let Some(k) = stack.pop() {
+            let Some(node) = self.nodes.get(k) else {
+                break;
+            };
+            if box_distance(node, p) > r {
+                continue;
+            }
+            if node.count > 0 {
+                for &t in self.leaf_triangles(node) {
+                    let [a, b, c] = self.surface.corners(t as usize);
+                    if (closest_on_triangle(p, a, b, c) - p).length() <= r {
+                        return None;
+                    }
+                }
+            } else {
+                let (l, r_) = (node.first as usize, node.first as usize + 1);
+                // The nearer child last, visited first: it most likely holds a near triangle.
+                if box_distance(&self.nodes[l], p) <= box_distance(&self.nodes[r_], p) {
+                    stack.extend([r_, l]);
+                } else {
+                    stack.extend([l, r_]);
+                }
+            }
+        }
+        self.closest(p).map(|c| c.distance)
+    }
+
     /// Every triangle the closed segment [p, q] meets, ordered by parameter then triangle id.
     pub fn crossings(&self, p: DVec3, q: DVec3) -> Vec<Crossing> {
         let mut out = Vec::new();

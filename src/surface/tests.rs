@@ -171,6 +171,13 @@ fn closest_point_matches_brute_force() {
             })
             .fold(f64::INFINITY, f64::min);
         assert!((fast.distance - brute).abs() <= 1e-12 * d, "{p}");
+        // Within a radius just above and just below the distance.
+        assert_eq!(o.distance_beyond(p, fast.distance * 1.001), None, "{p}");
+        assert_eq!(
+            o.distance_beyond(p, fast.distance * 0.999),
+            Some(fast.distance),
+            "{p}"
+        );
     }
 }
 
