@@ -99,7 +99,7 @@ if len(sys.argv) > 1 and sys.argv[1] == "--gmsh-worker":
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from compare_mesh3 import off_volume  # noqa: E402
-from meshcompare import Failure, check_executable, match_count, run_timed, table  # noqa: E402
+from meshcompare import Failure, check_executable, match_count, run_timed, size_args, table  # noqa: E402
 from quality_checks import figures  # noqa: E402
 
 
@@ -218,14 +218,14 @@ def compare(args, outdir):
         last["ours"] = h
         if os.path.exists(stats):
             os.remove(stats)
-        cmd = [args.slivermesh, "mesh", model, "-o", ours_mesh, "--size", "%.10g" % h,
-               "--stats-json", stats] + extra
+        cmd = [args.slivermesh, "mesh", model, "-o", ours_mesh] + size_args(h) + \
+              ["--stats-json", stats] + extra
         _, wall = run_timed(cmd)
         with open(stats) as f:
             res = json.load(f)
         res.update({"size": h, "wall_seconds": wall,
-                    "command": " ".join(["slivermesh", "mesh", os.path.basename(model), "--size",
-                                         "%.6g" % h] + extra)})
+                    "command": " ".join(["slivermesh", "mesh", os.path.basename(model)] +
+                                        size_args(h, "%.6g") + extra)})
         return res
 
     def gmsh_at(s):
@@ -245,7 +245,7 @@ def compare(args, outdir):
         return res
 
     print("%s (volume %.6g); choosing sizes:" % (model, volume))
-    if args.size:
+    if args.size is not None:
         h = args.size
         ours = ours_at(h)
         print("  %-12s param %.6g -> %d tets" % ("slivermesh", h, ours["n_tets"]))
@@ -269,7 +269,8 @@ def compare(args, outdir):
     for row, run in ((ours_m, ours), (gmsh_m, gm)):
         row["wall_seconds"] = run["wall_seconds"]
         row["tets_per_second"] = row["n_tets"] / run["wall_seconds"]
-        row["param"] = "--size %.4g" % run["size"] if run is ours else "size %.4g" % run["size"]
+        row["param"] = (" ".join(size_args(run["size"], "%.4g")) or "default size") \
+            if run is ours else "size %.4g" % run["size"]
         row["volume_rel_error"] = (row["volume"] - volume) / volume
         row["n_inverted_zero"] = [row["n_inverted"], row["n_zero_volume"]]
     gmsh_m["in_process_seconds"] = gm["seconds_in_process"]
@@ -358,7 +359,8 @@ def main():
                     help="the Python that runs Gmsh (needs `import gmsh`; default: this one)")
     ap.add_argument("--input", required=True, help="an .off model (e.g. models/off/fandisk.off)")
     size = ap.add_mutually_exclusive_group(required=True)
-    size.add_argument("--size", type=float, help="slivermesh's --size (fixed)")
+    size.add_argument("--size", type=float,
+                      help="slivermesh's --size (fixed; 0: its default spacing, no --size)")
     size.add_argument("--tets", type=int, help="instead of --size: adjust slivermesh's --size to about this many tets")
     ap.add_argument("--allow-incomplete", action="store_true",
                     help="report an incomplete slivermesh run (a bound missed by a few tets) "
@@ -391,8 +393,8 @@ def main():
     if not check_executable("slivermesh", args.slivermesh):
         return 2
     if args.repeat < 1 or args.max_runs < 1 or (args.tets is not None and args.tets < 50) \
-            or (args.size is not None and not args.size > 0):
-        print("error: --repeat and --max-runs must be >= 1, --tets >= 50, --size > 0", file=sys.stderr)
+            or (args.size is not None and not args.size >= 0):
+        print("error: --repeat and --max-runs must be >= 1, --tets >= 50, --size >= 0", file=sys.stderr)
         return 2
     try:
         shlex.split(args.slivermesh_args)

@@ -53,7 +53,7 @@ import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from meshcompare import (Failure, check_executable, keep_surface, match_count,  # noqa: E402
-                         run_timed, table)
+                         run_timed, size_args, table)
 
 
 def off_volume(path):
@@ -103,14 +103,14 @@ def compare_model(args, model, outdir):
     def ours_at(h):
         last["ours"] = h
         extra = keep_surface(args.slivermesh_arg + shlex.split(args.slivermesh_args))
-        cmd = [args.slivermesh, "mesh", model, "-o", ours_native, "--size", "%.10g" % h,
-               "--stats-json", stats] + extra
+        cmd = [args.slivermesh, "mesh", model, "-o", ours_native] + size_args(h) + \
+              ["--stats-json", stats] + extra
         _, wall = run_timed(cmd)
         with open(stats) as f:
             res = json.load(f)
         res.update({"size": h, "wall_seconds": wall,
-                    "command": "slivermesh mesh %s --size %.6g %s" % (os.path.basename(model), h,
-                                                                      " ".join(extra))})
+                    "command": " ".join(["slivermesh", "mesh", os.path.basename(model)] +
+                                        size_args(h, "%.6g") + extra)})
         return res
 
     def cgal_at(s):
@@ -124,7 +124,7 @@ def compare_model(args, model, outdir):
                                                                       " ".join(fa))})
         return res
 
-    if args.size:
+    if args.size is not None:
         print("%s (volume %.6g), slivermesh --size %g; choosing sizes:" % (model, volume, args.size))
         h, ours = args.size, ours_at(args.size)
         print("  %-12s param %.6g -> %d tets" % ("slivermesh", h, ours["n_tets"]))
@@ -138,7 +138,7 @@ def compare_model(args, model, outdir):
                           3.0, args.tol, args.max_runs, "CGAL Mesh_3")
     if last["cgal"] != s:
         cgal = cgal_at(s)
-    key = "wall_seconds" if args.size else "seconds_total"  # what the reruns minimise
+    key = "wall_seconds" if args.size is not None else "seconds_total"  # what the reruns minimise
     for _ in range(args.repeat - 1):  # timing reruns, best kept
         o, c = ours_at(h), cgal_at(s)
         if o[key] < ours[key]:
@@ -164,7 +164,8 @@ def compare_model(args, model, outdir):
     for r in (cgal, ours_row):
         r["tets_per_second"] = r["n_tets"] / r["seconds_total"] if r["seconds_total"] else None
     cgal["complete"] = True
-    cgal["param"], ours_row["param"] = "--size %.4g" % s, "--size %.4g" % h
+    cgal["param"] = "--size %.4g" % s
+    ours_row["param"] = " ".join(size_args(h, "%.4g")) or "default size"
     rows = [
         ("size parameter", "param", "s", False),
         ("vertices", "n_vertices", "d", True),
@@ -259,8 +260,9 @@ def main():
                     help="extra arguments for `slivermesh mesh` as one shell-quoted string, e.g. "
                          "--slivermesh-args='--surface approximate' (default none)")
     ap.add_argument("--size", type=float,
-                    help="slivermesh's --size, fixed (instead of adjusting it to --tets); CGAL's "
-                         "size is still adjusted to our tet count")
+                    help="slivermesh's --size, fixed (instead of adjusting it to --tets; 0: its "
+                         "default spacing, no --size); CGAL's size is still adjusted to our tet "
+                         "count")
     ap.add_argument("--feature-angle", type=float,
                     help="CGAL's detect_features() angle in degrees (default: CGAL's, 60)")
     ap.add_argument("--volume-rel-tol", type=float,
@@ -283,8 +285,8 @@ def main():
             return 2
     if not (check_executable("slivermesh", args.slivermesh) and check_executable("cgal_mesh3", args.cgal_mesh3)):
         return 2
-    if args.repeat < 1 or args.tets < 50 or (args.size is not None and not args.size > 0):
-        print("error: --repeat must be >= 1, --tets >= 50 and --size > 0", file=sys.stderr)
+    if args.repeat < 1 or args.tets < 50 or (args.size is not None and not args.size >= 0):
+        print("error: --repeat must be >= 1, --tets >= 50 and --size >= 0", file=sys.stderr)
         return 2
     try:
         shlex.split(args.slivermesh_args)

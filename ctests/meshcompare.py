@@ -71,6 +71,12 @@ def match_count(run_at, target, start, exponent, tol, max_runs, label, log=print
     return min(runs, key=lambda pr: abs(pr[1]["n_tets"] / target - 1.0))
 
 
+def size_args(h, spec="%.10g"):
+    """slivermesh's size arguments for size h: `--size h`, or none for h = 0 (its default,
+    graded spacing)."""
+    return ["--size", spec % h] if h else []
+
+
 def fmt(v, spec):
     if v is None:
         return "n/a"

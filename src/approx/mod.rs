@@ -92,47 +92,63 @@ pub fn mesh(
     Ok((mesh, report))
 }
 
-/// Volume refinements tried at most (see [`mesh_volume`]).
-const MAX_VOLUME_ATTEMPTS: usize = 6;
+/// Volume refinements tried at most (see [`mesh_volume`]), and of those with lazy
+/// encroachment.
+const MAX_VOLUME_ATTEMPTS: usize = 8;
+const MAX_LAZY_ATTEMPTS: usize = 2;
 
 /// Step 4. Boundary recovery can split without end at a vertex of the new boundary where
 /// several edges meet at small angles in different planes (saddles of noisy scans): when it
 /// fails at a facet, that facet's vertices are treated as small angles too and the volume
-/// is meshed again.
+/// is meshed again. The first attempts leave present boundary elements encroached
+/// (`Domain::lazy_encroachment`: far fewer splits and tets); when they fail the later ones
+/// make every element's ball empty first, as keep mode does.
 fn mesh_volume(
     remeshed: &mut Remeshed,
     params: &Params,
     spacing: Option<&dyn Spacing>,
     mut progress: Option<Progress>,
 ) -> Result<(TetMesh, Report), MeshError> {
-    let mut attempt = 0;
     let mut relay = |fraction: f64, n: usize| progress.as_mut().is_none_or(|p| p(fraction, n));
+    let mut lazy = true;
+    let (mut attempt, mut lazy_attempts) = (0, 0);
     loop {
         attempt += 1;
+        lazy_attempts += usize::from(lazy);
         let result = crate::refine::mesh_remeshed(
             &remeshed.boundary,
             params,
             spacing,
             Some(&mut relay),
             &remeshed.small_corner_vertices,
+            lazy,
         );
-        let failed_facet = match &result {
-            Err(MeshError::Internal(msg)) if attempt < MAX_VOLUME_ATTEMPTS => failing_facet(msg),
-            _ => None,
-        };
-        let Some(f) = failed_facet.filter(|&f| f < remeshed.boundary.facets.len()) else {
+        let Err(MeshError::Internal(msg)) = &result else {
             return result;
         };
-        let before = remeshed.small_corner_vertices.len();
-        remeshed
-            .small_corner_vertices
-            .extend(&remeshed.boundary.facets[f].polygons[0]);
-        remeshed.small_corner_vertices.sort_unstable();
-        remeshed.small_corner_vertices.dedup();
-        if remeshed.small_corner_vertices.len() == before {
+        if attempt >= MAX_VOLUME_ATTEMPTS {
+            return result;
+        }
+        let protected_more = failing_facet(msg)
+            .filter(|&f| f < remeshed.boundary.facets.len())
+            .is_some_and(|f| protect_facet(remeshed, f));
+        if lazy && (!protected_more || lazy_attempts == MAX_LAZY_ATTEMPTS) {
+            lazy = false;
+        } else if !protected_more {
             return result;
         }
     }
+}
+
+/// Treats the vertices of boundary facet `f` as small angles; false when they were already.
+fn protect_facet(remeshed: &mut Remeshed, f: usize) -> bool {
+    let before = remeshed.small_corner_vertices.len();
+    remeshed
+        .small_corner_vertices
+        .extend(&remeshed.boundary.facets[f].polygons[0]);
+    remeshed.small_corner_vertices.sort_unstable();
+    remeshed.small_corner_vertices.dedup();
+    remeshed.small_corner_vertices.len() > before
 }
 
 /// The facet an internal error of boundary recovery names ("facet N: ...").

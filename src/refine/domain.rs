@@ -54,6 +54,20 @@ pub struct Domain {
     /// Approximate mode only: per input segment and per input facet, the size below which a
     /// present but encroached subsegment / subfacet is left alone (`set_small_corners`).
     min_split_size: Option<(Vec<f64>, Vec<f64>)>,
+    /// Approximate mode only: boundary recovery (`recover::settle`) splits subsegments and
+    /// subfacets only when missing, not when present but encroached. The remeshed boundary
+    /// is restricted Delaunay, so every triangle is present already, but on a curved surface
+    /// most equatorial balls hold a neighbour: making them all empty split fandisk's 8k
+    /// boundary triangles into 40k. Refinement still splits an element its point encroaches.
+    /// Not within [`EAGER_REACH`] nearest-neighbour distances of a small angle (`eager`),
+    /// where refinement leaves the tets it cannot shape without breaking the boundary and
+    /// needs the boundary fine (lazy there too, elephant's worst tet fell from 7.5 to 3.1
+    /// degrees).
+    pub lazy_encroachment: bool,
+    /// Balls around the small-angle vertices (centre, squared radius; see
+    /// `lazy_encroachment`) and, per vertex, whether it lies in one.
+    eager_balls: Vec<(DVec3, f64)>,
+    eager: Vec<bool>,
     /// `Params::small_angle_reach`.
     small_angle_reach: f64,
     /// Protecting balls around the acute input vertices: vertex -> radius. Inside one,
@@ -87,6 +101,10 @@ pub const MIN_SPLIT_FRACTION: f64 = 1.0 / 16.0;
 
 /// `Domain::apex` of a vertex in no protecting ball.
 pub const NO_APEX: u32 = u32::MAX;
+
+/// Radius of the balls around small-angle vertices where recovery stays eager under
+/// `Domain::lazy_encroachment`, in nearest-neighbour distances of the vertex.
+pub const EAGER_REACH: f64 = 4.0;
 
 pub fn seg_key(a: u32, b: u32) -> (u32, u32) {
     (a.min(b), a.max(b))
@@ -164,6 +182,9 @@ impl Domain {
             acute_facets: FxHashSet::default(),
             near_small_angle: vec![false; input.vertices.len()],
             min_split_size: None,
+            lazy_encroachment: false,
+            eager_balls: vec![],
+            eager: vec![],
             small_angle_reach: f64::INFINITY,
             dirty_segs: vec![],
             dirty_tris: vec![],
@@ -221,7 +242,7 @@ impl Domain {
     /// triangle's size can only be a cascade (two triangles of a curved patch whose splits
     /// encroach each other): below [`MIN_SPLIT_FRACTION`] of its input segment or of its input
     /// facet's shortest edge, an element is split only when missing.
-    pub fn set_small_corners(&mut self, vertices: &[u32], reach: f64) {
+    pub fn set_small_corners(&mut self, vertices: &[u32], reach: f64, lazy: bool) {
         self.small_angle_reach = reach;
         let seg_len: Vec<f64> = self
             .segments
@@ -236,6 +257,17 @@ impl Domain {
             }
         }
         self.min_split_size = Some((seg_len, facet_edge));
+        self.lazy_encroachment = lazy;
+        self.eager_balls = vertices
+            .iter()
+            .map(|&v| {
+                let r = EAGER_REACH * nearest_neighbor_distance(&self.dt, v);
+                (self.point(v), r * r)
+            })
+            .collect();
+        self.eager = (0..self.kind.len() as u32)
+            .map(|v| self.in_eager_ball(self.point(v)))
+            .collect();
         for &v in vertices {
             let r = PROTECT_FRACTION * nearest_neighbor_distance(&self.dt, v);
             self.protect_radius.insert(v, r);
@@ -339,6 +371,18 @@ impl Domain {
             || self.below_min_split_size(verts)
     }
 
+    fn in_eager_ball(&self, p: DVec3) -> bool {
+        self.eager_balls
+            .iter()
+            .any(|&(c, r2)| p.distance_squared(c) <= r2)
+    }
+
+    /// Whether recovery leaves the boundary element with vertices `verts` alone when it is
+    /// present but encroached (see `lazy_encroachment`).
+    pub fn lazily_encroached(&self, verts: &[u32]) -> bool {
+        self.lazy_encroachment && !verts.iter().any(|&v| self.eager[v as usize])
+    }
+
     /// See `set_small_corners`.
     fn below_min_split_size(&self, verts: &[u32]) -> bool {
         let Some((seg_len, facet_edge)) = &self.min_split_size else {
@@ -382,6 +426,10 @@ impl Domain {
                 self.apex.push(apex);
                 let near = self.is_near_small_angle(id, p, kind);
                 self.near_small_angle.push(near);
+                if !self.eager.is_empty() {
+                    let eager = self.in_eager_ball(p);
+                    self.eager.push(eager);
+                }
                 self.queue_around_last_insertion();
                 self.created_log.extend_from_slice(self.dt.last_created());
                 Ok(id)
