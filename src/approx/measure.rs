@@ -19,11 +19,18 @@ use glam::DVec3;
 const HAUSDORFF_SPACING: f64 = 1.0 / 200.0;
 const MIN_PIECES: usize = 3;
 
-/// Largest distance from samples of `from` to `to`.
-fn one_sided(from: &InputSurface, to: &InputSurface, spacing: f64) -> f64 {
+/// The points of `surface` where the Hausdorff distance is sampled.
+pub(super) fn hausdorff_samples(surface: &InputSurface) -> Vec<DVec3> {
+    let spacing = HAUSDORFF_SPACING * surface.bbox_diagonal();
+    samples_per_edge_at_least(surface, spacing, MIN_PIECES)
+}
+
+/// Largest distance from samples of `from` to `to` (spacing as [`hausdorff_samples`], by
+/// `from`'s own diagonal).
+fn one_sided(from: &InputSurface, to: &InputSurface) -> f64 {
     let oracle = SurfaceOracle::new(to);
     let mut worst: f64 = 0.0;
-    for p in samples_per_edge_at_least(from, spacing, MIN_PIECES) {
+    for p in hausdorff_samples(from) {
         if let Some(d) = oracle.distance_beyond(p, worst) {
             worst = worst.max(d);
         }
@@ -38,7 +45,6 @@ pub fn surface_report(r: &Remeshed, mesh: &TetMesh) -> SurfaceReport {
     // The output boundary is the remeshed triangles subdivided in their own planes (keep mode
     // on them): the same surface, with far fewer triangles to sample.
     let out = remeshed_surface(r);
-    let spacing = HAUSDORFF_SPACING * r.surface.bbox_diagonal();
     let out_volume: f64 = mesh
         .tets
         .iter()
@@ -49,8 +55,8 @@ pub fn surface_report(r: &Remeshed, mesh: &TetMesh) -> SurfaceReport {
         .sum();
     SurfaceReport {
         surface_distance: r.distance,
-        hausdorff_input_to_output: one_sided(&r.surface, &out, spacing),
-        hausdorff_output_to_input: one_sided(&out, &r.surface, spacing),
+        hausdorff_input_to_output: one_sided(&r.surface, &out),
+        hausdorff_output_to_input: one_sided(&out, &r.surface),
         feature_distance: feature_distance(r),
         relative_volume_difference: if r.input_volume > 0.0 {
             (out_volume - r.input_volume) / r.input_volume

@@ -199,6 +199,7 @@ pub fn remesh(
     let oracle = SurfaceOracle::new(&surface);
     let criteria = SurfaceCriteria {
         distance: DISTANCE_SAFETY * distance,
+        bound: distance,
         min_angle_deg: FACET_MIN_ANGLE_DEG,
         max_vertices: params.max_vertices,
         seed: params.seed,

@@ -39,6 +39,10 @@ pub struct SurfaceCriteria {
     /// Largest distance between a facet's circumcentre and its surface centre, and between a
     /// subsegment's chord and its curve.
     pub distance: f64,
+    /// The distance bound itself: no sample of the input may lie farther from the extracted
+    /// boundary (a valley of a noisy scan can stray from triangles whose circumcentres and
+    /// centroids all lie close to the input).
+    pub bound: f64,
     /// Smallest facet angle, degrees (CGAL's facet_angle; 30 is the guaranteed-terminating
     /// bound of Boissonnat & Oudot).
     pub min_angle_deg: f64,
@@ -357,9 +361,12 @@ impl<'a> SurfaceMesher<'a> {
             if stop_reason.is_some() {
                 break;
             }
-            let (faces, problems) = self.extract();
+            let (faces, mut problems) = self.extract();
             if problems.is_empty() {
-                return Ok(self.boundary(faces, None));
+                problems = self.far_from_input(&faces);
+                if problems.is_empty() {
+                    return Ok(self.boundary(faces, None));
+                }
             }
             for (t, i) in problems {
                 if let Some(r) = self.facet_at(t, i) {
@@ -724,6 +731,28 @@ impl<'a> SurfaceMesher<'a> {
     }
 
     /// The boundary from the extracted faces, oriented outwards, vertices renumbered.
+    /// The boundary faces nearest to the samples of the input the report's Hausdorff
+    /// distance takes (`measure::hausdorff_samples`) that lie farther than the bound from
+    /// them, away from small corners, where the surface is left coarse on purpose.
+    fn far_from_input(&self, faces: &[FaceRef]) -> Vec<FaceRef> {
+        let triangles = faces
+            .iter()
+            .map(|&(t, i)| FACE[i].map(|k| self.dt.tet(t)[k]))
+            .collect();
+        let extracted = InputSurface::from_triangles(self.dt.points().to_vec(), triangles);
+        let near = SurfaceOracle::new(&extracted);
+        let points = super::measure::hausdorff_samples(self.surface);
+        let mut far: Vec<FaceRef> = points
+            .into_iter()
+            .filter(|&p| near.distance_beyond(p, self.criteria.bound).is_some())
+            .filter(|&p| !self.near_small_corner(p))
+            .filter_map(|p| near.closest(p).map(|c| faces[c.triangle as usize]))
+            .collect();
+        far.sort_unstable();
+        far.dedup();
+        far
+    }
+
     fn boundary(&self, faces: Vec<FaceRef>, stop_reason: Option<String>) -> Boundary {
         let mut out = Boundary {
             stop_reason,
