@@ -69,6 +69,7 @@ pub fn surface_report(r: &Remeshed, mesh: &TetMesh) -> SurfaceReport {
         n_patches: r.features.n_patches,
         n_small_corners: r.small_corners.len(),
         n_bad_near_small_corners: 0,
+        max_rho_away_from_small_corners: 0.0,
         n_surface_vertices: r.boundary.vertices.len(),
         n_surface_triangles: r.boundary.facets.len(),
         seconds_surface: r.seconds,
@@ -112,26 +113,32 @@ fn feature_distance(r: &Remeshed) -> f64 {
     worst
 }
 
-/// Tets with a vertex within twice the protecting radius of a small corner whose radius-edge
-/// ratio or smallest dihedral angle misses the refinement's bound.
-pub fn bad_near_corners(mesh: &TetMesh, corners: &[(DVec3, f64)], params: &Params) -> usize {
-    if corners.is_empty() {
-        return 0;
+/// Of the tets with a vertex within twice the protecting radius of a small corner (its
+/// influence): how many miss the refinement's radius-edge or dihedral bound; and the largest
+/// radius-edge ratio of all the other tets.
+pub fn small_corner_figures(
+    mesh: &TetMesh,
+    corners: &[(DVec3, f64)],
+    params: &Params,
+) -> (usize, f64) {
+    let mut bad_near = 0;
+    let mut max_rho_away: f64 = 0.0;
+    for t in &mesh.tets {
+        let p = t.map(|v| mesh.vertices[v as usize]);
+        let rho = radius_edge_ratio(p[0], p[1], p[2], p[3]);
+        let near = p.iter().any(|q| {
+            corners
+                .iter()
+                .any(|(c, r)| (*q - *c).length_squared() < 4.0 * r * r)
+        });
+        if !near {
+            max_rho_away = max_rho_away.max(rho);
+            continue;
+        }
+        let (lo, _) = min_max_dihedral(p[0], p[1], p[2], p[3]);
+        if lo < params.min_dihedral || rho > params.rho0 {
+            bad_near += 1;
+        }
     }
-    mesh.tets
-        .iter()
-        .filter(|t| {
-            let p = t.map(|v| mesh.vertices[v as usize]);
-            let near = p.iter().any(|q| {
-                corners
-                    .iter()
-                    .any(|(c, r)| (*q - *c).length_squared() < 4.0 * r * r)
-            });
-            if !near {
-                return false;
-            }
-            let (lo, _) = min_max_dihedral(p[0], p[1], p[2], p[3]);
-            lo < params.min_dihedral || radius_edge_ratio(p[0], p[1], p[2], p[3]) > params.rho0
-        })
-        .count()
+    (bad_near, max_rho_away)
 }

@@ -85,8 +85,10 @@ pub fn mesh(
     if report.stop_reason.is_none() {
         report.stop_reason = remeshed.stop_reason.clone();
     }
-    surface_report.n_bad_near_small_corners =
-        measure::bad_near_corners(&mesh, &remeshed.small_corners, params);
+    (
+        surface_report.n_bad_near_small_corners,
+        surface_report.max_rho_away_from_small_corners,
+    ) = measure::small_corner_figures(&mesh, &remeshed.small_corners, params);
     report.surface = Some(surface_report);
     report.seconds_total = start.elapsed().as_secs_f64();
     Ok((mesh, report))

@@ -122,10 +122,17 @@ fn fandisk_meets_the_distance_and_angle_bounds() {
     assert_eq!(s.n_small_corners, 1);
     assert!(s.n_patches >= 10, "{s:?}");
     let q = crate::quality::measure(&mesh).unwrap();
+    // The floor is 15 degrees on models without small corners and 12 elsewhere; the
+    // approximate mode's improvement target is 20.
     assert!(
-        q.min_dihedral_deg >= 12.0,
+        q.min_dihedral_deg >= 15.0,
         "min dihedral {}",
         q.min_dihedral_deg
+    );
+    let rho_away = s.max_rho_away_from_small_corners;
+    assert!(
+        rho_away > 0.5 && rho_away <= 2.0,
+        "max rho away from the small corner {rho_away}"
     );
 }
 

@@ -275,6 +275,10 @@ fn surface_table(s: &SurfaceReport) -> String {
         format!("{} / {}", s.n_small_corners, s.n_bad_near_small_corners),
     );
     row(
+        "max rho away from them",
+        format!("{:.4}", s.max_rho_away_from_small_corners),
+    );
+    row(
         "surface vertices / triangles",
         format!("{} / {}", s.n_surface_vertices, s.n_surface_triangles),
     );

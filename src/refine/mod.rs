@@ -312,6 +312,8 @@ pub struct SurfaceReport {
     /// 60 degrees, and the output tets within their influence that miss a bound.
     pub n_small_corners: usize,
     pub n_bad_near_small_corners: usize,
+    /// The largest radius-edge ratio of the tets outside every small corner's influence.
+    pub max_rho_away_from_small_corners: f64,
     /// Vertices and triangles of the remeshed boundary.
     pub n_surface_vertices: usize,
     pub n_surface_triangles: usize,
