@@ -55,7 +55,7 @@ impl Default for Options {
             improve: true,
             target_deg: 26.0,
             max_passes: 4,
-            max_rho: 2.0,
+            max_rho: f64::INFINITY,
         }
     }
 }
@@ -300,7 +300,8 @@ pub fn update_report(report: &mut Report, mesh: &TetMesh) {
 }
 
 /// The step every mesher output goes through: improvement (or, with `params.improve` false,
-/// only the removal of flat and inverted tets; tets over `params.rho0` count as bad), the check that no tet is degenerate, and the
+/// only the removal of flat and inverted tets; in approximate mode tets over `params.rho0`
+/// count as bad), the check that no tet is degenerate, and the
 /// report's shape figures re-measured when the mesh changed.
 pub fn finish(
     mesh: TetMesh,
@@ -310,7 +311,12 @@ pub fn finish(
 ) -> Result<TetMesh, MeshError> {
     let opts = Options {
         improve: params.improve,
-        max_rho: params.rho0,
+        // Keep mode leaves tets over rho0 next to small input angles, where the cap made the
+        // improver trade angles for them (spool: 4 -> 61 tets below 5 degrees): angles only.
+        max_rho: match params.surface_mode {
+            crate::refine::SurfaceMode::Approximate => params.rho0,
+            crate::refine::SurfaceMode::Keep => f64::INFINITY,
+        },
         target_deg: params.effective_improve_target(),
         ..Options::default()
     };
