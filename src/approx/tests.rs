@@ -170,3 +170,37 @@ fn failing_facet_is_read_from_recovery_errors() {
     );
     assert_eq!(failing_facet("boundary recovery did not terminate"), None);
 }
+
+/// Every triangulated model but the noisy elephant scan (minutes), at the defaults: completes
+/// with positive tets, the Hausdorff, feature and volume bounds (`check_mesh`), min dihedral
+/// >= 15 degrees (12 with a small corner) and radius-edge ratios away from small corners at
+/// most 2 (2.05 here: rotor leaves one tet at 2.02, docs/approximate.md). joint ran for ever
+/// before the refinement stopped drawing points from flat tets' noise spheres. Release builds
+/// only (about a minute; ten in a debug build).
+#[test]
+fn models_meet_the_bounds_at_the_defaults() {
+    if cfg!(debug_assertions) {
+        eprintln!("skipped in a debug build: run cargo test --release");
+        return;
+    }
+    let models = [
+        "cube", "cross", "star", "oblong", "part", "rotor", "spool", "anchor", "fandisk", "joint",
+    ];
+    for name in models {
+        let path = format!("off/{name}.off");
+        let (mesh, report) = check_mesh(&path, None);
+        let s = report.surface.unwrap();
+        let q = crate::quality::measure(&mesh).unwrap();
+        let floor = if s.n_small_corners == 0 { 15.0 } else { 12.0 };
+        assert!(
+            q.min_dihedral_deg >= floor,
+            "{name}: min dihedral {}",
+            q.min_dihedral_deg
+        );
+        assert!(
+            s.max_rho_away_from_small_corners <= 2.05,
+            "{name}: max rho away from small corners {}",
+            s.max_rho_away_from_small_corners
+        );
+    }
+}
