@@ -172,9 +172,10 @@ fn failing_facet_is_read_from_recovery_errors() {
 }
 
 /// Every triangulated model but the noisy elephant scan (minutes), at the defaults: completes
-/// with positive tets, the Hausdorff, feature and volume bounds (`check_mesh`), min dihedral
-/// >= 15 degrees (12 with a small corner) and radius-edge ratios away from small corners at
-/// most 2 (2.05 here: rotor leaves one tet at 2.02, docs/approximate.md). joint ran for ever
+/// with positive tets, the Hausdorff, feature and volume bounds (`check_mesh`), a minimum
+/// dihedral angle of at least 15 degrees (12 with a small corner) and radius-edge ratios away
+/// from small corners at most 2 (2.05 here: rotor leaves one tet at 2.02, docs/approximate.md).
+/// joint ran for ever
 /// before the refinement stopped drawing points from flat tets' noise spheres. Release builds
 /// only (about a minute; ten in a debug build).
 #[test]
