@@ -48,7 +48,8 @@ const MAX_EXACT_INT: f64 = 9_007_199_254_740_992.0; // 2^53
 /// describe), `feature_angle` (degrees, in (0, 180): approximate mode's sharp-edge threshold),
 /// `surface_distance` (finite, >= 0: approximate mode's distance bound; 0 = the default, 0.001 x
 /// the bounding-box diagonal), `improve_target` (degrees in [0, 40]: improvement works on tets
-/// with a smaller dihedral angle; 0 = the mode's default, 26 keep / 20 approximate). Integer and 0/1 parameters must be given as whole numbers.
+/// with a smaller dihedral angle; 0 = the mode's default, 26 keep / 20 approximate). Integer
+/// and 0/1 parameters must be given as whole numbers.
 /// The result also passes `Params::check` (the refiner's own validation), so a value accepted
 /// here is never refused by `refine`.
 pub fn set_param(params: &mut Params, name: &str, value: f64) -> Result<(), Error> {

@@ -730,7 +730,6 @@ impl<'a> SurfaceMesher<'a> {
         (faces, problems)
     }
 
-    /// The boundary from the extracted faces, oriented outwards, vertices renumbered.
     /// The boundary faces nearest to the samples of the input the report's Hausdorff
     /// distance takes (`measure::hausdorff_samples`) that lie farther than the bound from
     /// them, away from small corners, where the surface is left coarse on purpose.
@@ -753,6 +752,7 @@ impl<'a> SurfaceMesher<'a> {
         far
     }
 
+    /// The boundary from the extracted faces, oriented outwards, vertices renumbered.
     fn boundary(&self, faces: Vec<FaceRef>, stop_reason: Option<String>) -> Boundary {
         let mut out = Boundary {
             stop_reason,

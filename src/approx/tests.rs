@@ -175,9 +175,8 @@ fn failing_facet_is_read_from_recovery_errors() {
 /// with positive tets, the Hausdorff, feature and volume bounds (`check_mesh`), a minimum
 /// dihedral angle of at least 15 degrees (12 with a small corner) and radius-edge ratios away
 /// from small corners at most 2 (2.05 here: rotor leaves one tet at 2.02, docs/approximate.md).
-/// joint ran for ever
-/// before the refinement stopped drawing points from flat tets' noise spheres. Release builds
-/// only (about a minute; ten in a debug build).
+/// joint ran for ever before the refinement stopped drawing points from flat tets' noise
+/// spheres. Release builds only (about a minute; ten in a debug build).
 #[test]
 fn models_meet_the_bounds_at_the_defaults() {
     if cfg!(debug_assertions) {

@@ -52,7 +52,7 @@ pub struct MeshOptions {
     #[arg(long)]
     pub no_improve: bool,
     /// Improvement works on tets whose smallest dihedral angle is below DEG degrees (in
-    /// (0, 40]; default 26 in keep mode, 20 in approximate mode).
+    /// [0, 40]; 0 or absent: 26 in keep mode, 20 in approximate mode).
     #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
     pub improve_target: Option<f64>,
     /// keep: every input facet is preserved exactly; approximate: the input triangles describe

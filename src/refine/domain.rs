@@ -59,13 +59,13 @@ pub struct Domain {
     /// is restricted Delaunay, so every triangle is present already, but on a curved surface
     /// most equatorial balls hold a neighbour: making them all empty split fandisk's 8k
     /// boundary triangles into 40k. Refinement still splits an element its point encroaches.
-    /// Not within [`EAGER_REACH`] nearest-neighbour distances of a small angle (`eager`),
-    /// where refinement leaves the tets it cannot shape without breaking the boundary and
-    /// needs the boundary fine (lazy there too, elephant's worst tet fell from 7.5 to 3.1
-    /// degrees).
+    /// Recovery stays eager within [`EAGER_REACH`] nearest-neighbour distances of a
+    /// small-angle vertex (`eager`): refinement leaves tets there that it cannot shape
+    /// without breaking the boundary, and they need a fine boundary (lazy there as well,
+    /// elephant's worst tet fell from 7.5 to 3.1 degrees).
     pub lazy_encroachment: bool,
-    /// Balls around the small-angle vertices (centre, squared radius; see
-    /// `lazy_encroachment`) and, per vertex, whether it lies in one.
+    /// Under lazy encroachment: balls around the small-angle vertices (centre, squared
+    /// radius) and, per vertex, whether it lies in one (empty otherwise).
     eager_balls: Vec<(DVec3, f64)>,
     eager: Vec<bool>,
     /// `Params::small_angle_reach`.
@@ -258,21 +258,20 @@ impl Domain {
         }
         self.min_split_size = Some((seg_len, facet_edge));
         self.lazy_encroachment = lazy;
-        self.eager_balls = vertices
-            .iter()
-            .map(|&v| {
-                let r = EAGER_REACH * nearest_neighbor_distance(&self.dt, v);
-                (self.point(v), r * r)
-            })
-            .collect();
-        self.eager = (0..self.kind.len() as u32)
-            .map(|v| self.in_eager_ball(self.point(v)))
-            .collect();
         for &v in vertices {
-            let r = PROTECT_FRACTION * nearest_neighbor_distance(&self.dt, v);
-            self.protect_radius.insert(v, r);
+            let nearest = nearest_neighbor_distance(&self.dt, v);
+            self.protect_radius.insert(v, PROTECT_FRACTION * nearest);
             self.apex[v as usize] = v;
             self.small_angle_vertices.insert(v);
+            if lazy {
+                let r = EAGER_REACH * nearest;
+                self.eager_balls.push((self.point(v), r * r));
+            }
+        }
+        if lazy {
+            self.eager = (0..self.kind.len() as u32)
+                .map(|v| self.in_eager_ball(self.point(v)))
+                .collect();
         }
         self.record_facet_apexes();
         self.mark_near_small_angles();
