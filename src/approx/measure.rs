@@ -30,8 +30,10 @@ pub(super) fn hausdorff_samples(surface: &InputSurface) -> Vec<DVec3> {
 fn one_sided(from: &InputSurface, to: &InputSurface) -> f64 {
     let oracle = SurfaceOracle::new(to);
     let mut worst: f64 = 0.0;
+    // Consecutive samples come from one triangle: the last triangle found is tried first.
+    let mut hint = None;
     for p in hausdorff_samples(from) {
-        if let Some(d) = oracle.distance_beyond(p, worst) {
+        if let Some(d) = oracle.distance_beyond_hinted(p, worst, &mut hint) {
             worst = worst.max(d);
         }
     }

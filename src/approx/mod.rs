@@ -30,7 +30,7 @@ use crate::surface::features::{FeatureParams, Features};
 use crate::surface::oracle::SurfaceOracle;
 use crate::surface::InputSurface;
 use curves::FeatureCurves;
-use restricted::{SurfaceCriteria, SurfaceMesher};
+use restricted::{SurfaceCriteria, SurfaceMesher, VolumeCriteria, VolumeMesh};
 
 /// Default spacing of the boundary when the caller gives none, as a share of the bounding-box
 /// diagonal (curved patches get finer through the distance bound, the volume is graded from
@@ -78,8 +78,7 @@ pub fn mesh(
     progress: Option<Progress>,
 ) -> Result<(TetMesh, Report), MeshError> {
     let start = std::time::Instant::now();
-    let mut remeshed = remesh(input, params, spacing)?;
-    let (mesh, mut report) = mesh_volume(&mut remeshed, params, spacing, progress)?;
+    let (remeshed, mesh, mut report) = mesh_restricted(input, params, spacing, progress)?;
     let mesh = crate::improve::finish(mesh, &mut report, Some(&remeshed.boundary), params)?;
     let mut surface_report = measure::surface_report(&remeshed, &mesh);
     if report.stop_reason.is_none() {
@@ -94,69 +93,70 @@ pub fn mesh(
     Ok((mesh, report))
 }
 
-/// Volume refinements tried at most (see [`mesh_volume`]), and of those with lazy
-/// encroachment.
-const MAX_VOLUME_ATTEMPTS: usize = 8;
-const MAX_LAZY_ATTEMPTS: usize = 2;
-
-/// Step 4. Boundary recovery can split without end at a vertex of the new boundary where
-/// several edges meet at small angles in different planes (saddles of noisy scans): when it
-/// fails at a facet, that facet's vertices are treated as small angles too and the volume
-/// is meshed again. The first attempts leave present boundary elements encroached
-/// (`Domain::lazy_encroachment`: far fewer splits and tets); when they fail the later ones
-/// make every element's ball empty first, as keep mode does.
-fn mesh_volume(
-    remeshed: &mut Remeshed,
+/// Steps 3 and 4 in one triangulation: the restricted Delaunay surface, then its cells
+/// refined (`restricted::volume`).
+fn mesh_restricted(
+    input: &PlcInput,
     params: &Params,
     spacing: Option<&dyn Spacing>,
-    mut progress: Option<Progress>,
-) -> Result<(TetMesh, Report), MeshError> {
-    let mut relay = |fraction: f64, n: usize| progress.as_mut().is_none_or(|p| p(fraction, n));
-    let mut lazy = true;
-    let (mut attempt, mut lazy_attempts) = (0, 0);
-    loop {
-        attempt += 1;
-        lazy_attempts += usize::from(lazy);
-        let result = crate::refine::mesh_remeshed(
-            &remeshed.boundary,
-            params,
-            spacing,
-            Some(&mut relay),
-            &remeshed.small_corner_vertices,
-            lazy,
-        );
-        let Err(MeshError::Internal(msg)) = &result else {
-            return result;
-        };
-        if attempt >= MAX_VOLUME_ATTEMPTS {
-            return result;
-        }
-        let protected_more = failing_facet(msg)
-            .filter(|&f| f < remeshed.boundary.facets.len())
-            .is_some_and(|f| protect_facet(remeshed, f));
-        if lazy && (!protected_more || lazy_attempts == MAX_LAZY_ATTEMPTS) {
-            lazy = false;
-        } else if !protected_more {
-            return result;
-        }
+    progress: Option<Progress>,
+) -> Result<(Remeshed, TetMesh, Report), MeshError> {
+    let crit = VolumeCriteria {
+        rho0: params.rho0,
+        sigma0: params.sigma0,
+        min_dihedral_deg: params.min_dihedral,
+        delta: params.delta,
+        b: params.b,
+        max_tries: params.max_tries,
+        size_factor: params.size_factor,
+        user_spacing: spacing.is_some(),
+        seed: params.seed,
+    };
+    let start = std::time::Instant::now();
+    let (mut remeshed, volume) = remesh(input, params, spacing, Some((crit, progress)))?;
+    let volume = volume.ok_or_else(|| MeshError::Internal("no volume".into()))?;
+    remeshed.seconds -= volume.seconds_volume;
+    let attribute = input.regions.first().map_or(0, |r| r.attribute);
+    let mesh = TetMesh {
+        tet_regions: vec![attribute; volume.tets.len()],
+        vertices: volume.vertices,
+        tets: volume.tets,
+        boundary: remeshed
+            .boundary
+            .facets
+            .iter()
+            .map(|f| [f.polygons[0][0], f.polygons[0][1], f.polygons[0][2]])
+            .collect(),
+        boundary_markers: remeshed.boundary.facets.iter().map(|f| f.marker).collect(),
+    };
+    let default_spacing =
+        ConstantSpacing(DEFAULT_SPACING_FRACTION * remeshed.surface.bbox_diagonal());
+    let f: &dyn Spacing = match (spacing, &volume.spacing) {
+        (Some(s), _) => s,
+        (None, Some(s)) => s,
+        (None, None) => &default_spacing,
+    };
+    let corners = &remeshed.small_corners;
+    let near = |t: &[u32; 4]| {
+        t.iter().any(|&v| {
+            let p = mesh.vertices[v as usize];
+            corners
+                .iter()
+                .any(|&(c, r)| (p - c).length_squared() <= r * r)
+        })
+    };
+    let (mut report, bad_elsewhere) = crate::refine::report::measure(&mesh, f, params, &near)?;
+    report.seconds_refinement = volume.seconds_volume;
+    report.seconds_total = start.elapsed().as_secs_f64();
+    report.n_acute_angles = remeshed.small_corner_vertices.len();
+    report.stop_reason = remeshed.stop_reason.clone();
+    report.complete = report.stop_reason.is_none() && bad_elsewhere == 0;
+    if report.stop_reason.is_none() && bad_elsewhere > 0 {
+        report.stop_reason = Some(format!(
+            "{bad_elsewhere} tets away from small corners still violate a bound"
+        ));
     }
-}
-
-/// Treats the vertices of boundary facet `f` as small angles; false when they were already.
-fn protect_facet(remeshed: &mut Remeshed, f: usize) -> bool {
-    let before = remeshed.small_corner_vertices.len();
-    remeshed
-        .small_corner_vertices
-        .extend(&remeshed.boundary.facets[f].polygons[0]);
-    remeshed.small_corner_vertices.sort_unstable();
-    remeshed.small_corner_vertices.dedup();
-    remeshed.small_corner_vertices.len() > before
-}
-
-/// The facet an internal error of boundary recovery names ("facet N: ...").
-fn failing_facet(msg: &str) -> Option<usize> {
-    let rest = msg.strip_prefix("facet ")?;
-    rest.split(':').next()?.trim().parse().ok()
+    Ok((remeshed, mesh, report))
 }
 
 /// Steps 1-3: the new boundary.
@@ -164,7 +164,8 @@ pub fn remesh(
     input: &PlcInput,
     params: &Params,
     spacing: Option<&dyn Spacing>,
-) -> Result<Remeshed, MeshError> {
+    volume: Option<(VolumeCriteria, Option<Progress>)>,
+) -> Result<(Remeshed, Option<VolumeMesh>), MeshError> {
     let start = std::time::Instant::now();
     params.check().map_err(MeshError::InvalidInput)?;
     let plc = crate::plc::validate(input).map_err(|e| MeshError::InvalidInput(e.to_string()))?;
@@ -207,7 +208,13 @@ pub fn remesh(
         seed: params.seed,
     };
     let mesher = SurfaceMesher::new(&surface, &oracle, &curves, &features.patch_of, f, criteria)?;
-    let b = mesher.run()?;
+    let (b, volume) = match volume {
+        Some((crit, progress)) => {
+            let (b, v) = mesher.run_with_volume(crit, progress)?;
+            (b, Some(v))
+        }
+        None => (mesher.run()?, None),
+    };
     let labels = has_labels(input);
     let facets = b
         .triangles
@@ -250,7 +257,7 @@ pub fn remesh(
                     .any(|c| (p - c.point).length_squared() <= c.protect_radius * c.protect_radius)
         })
         .collect();
-    Ok(Remeshed {
+    let remeshed = Remeshed {
         small_corner_vertices,
         input_volume: plc.volume(),
         n_corners: curves.corners.len(),
@@ -262,7 +269,8 @@ pub fn remesh(
         distance,
         stop_reason: b.stop_reason,
         seconds: start.elapsed().as_secs_f64(),
-    })
+    };
+    Ok((remeshed, volume))
 }
 
 /// Whether the facet markers are the input's own labels: readers of plain surfaces number

@@ -19,12 +19,16 @@
 //! farther than the distance bound from its surface centre. Bad facets are refined largest
 //! first, each at its surface centre.
 
+mod volume;
+
+pub use volume::VolumeCriteria;
+
 use super::curves::{Curve, FeatureCurves};
 use crate::delaunay::tables::FACE;
 use crate::delaunay::{Delaunay, Inserted, INFINITE};
 use crate::geom::{circumcenter, tri_circumcenter};
 use crate::refine::{MeshError, Spacing};
-use crate::surface::oracle::{Side, SurfaceOracle};
+use crate::surface::oracle::{Crossing, Side, SurfaceOracle};
 use crate::surface::InputSurface;
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
@@ -60,6 +64,8 @@ pub enum Loc {
     Corner(u32),
     Curve(u32),
     Patch(u32),
+    /// Inserted by the cell level, inside the domain.
+    Volume,
 }
 
 /// A piece of a feature curve between two consecutive vertices on it.
@@ -154,6 +160,8 @@ pub struct SurfaceMesher<'a> {
     deferrals: FxHashMap<[u32; 3], u32>,
     bad_spacing: Option<MeshError>,
     min_length: f64,
+    /// The cell level, once the surface is good (`run_with_volume`).
+    vol: Option<Box<volume::VolumeState>>,
 }
 
 /// The surface mesh stops (with a reason) at this many times its initial samples: the
@@ -211,6 +219,7 @@ impl<'a> SurfaceMesher<'a> {
             deferrals: FxHashMap::default(),
             bad_spacing: None,
             min_length: 1e-9 * diagonal,
+            vol: None,
         };
         let mut points = far_box(surface, diagonal);
         m.loc = vec![Loc::Far; points.len()];
@@ -352,9 +361,54 @@ impl<'a> SurfaceMesher<'a> {
     /// then extracts the boundary; repeats while the boundary is not a closed 2-manifold of
     /// surface vertices.
     pub fn run(mut self) -> Result<Boundary, MeshError> {
+        let (faces, stop_reason) = self.rounds(&mut Self::refine)?;
+        Ok(self.boundary(faces, stop_reason))
+    }
+
+    /// [`Self::run`], then the cell level (`volume`) in the same triangulation: the boundary
+    /// and the tets inside it.
+    pub fn run_with_volume(
+        mut self,
+        crit: VolumeCriteria,
+        mut progress: Option<crate::refine::Progress>,
+    ) -> Result<(Boundary, VolumeMesh), MeshError> {
+        let start = std::time::Instant::now();
+        let (faces, stop_reason) = self.rounds(&mut Self::refine)?;
+        let seconds_surface = start.elapsed().as_secs_f64();
+        if stop_reason.is_some() {
+            return Err(MeshError::InvalidInput(format!(
+                "surface mode approximate: {}",
+                stop_reason.unwrap_or_default()
+            )));
+        }
+        self.start_volume(crit, &faces);
+        let mut cancelled = false;
+        let (faces, stop_reason) = self.rounds(&mut |m: &mut Self| {
+            let reason = m.refine_volume(&mut progress);
+            cancelled |= reason.is_none() && m.vol.as_ref().is_some_and(|v| v.cancelled());
+            reason
+        })?;
+        if cancelled {
+            return Err(MeshError::Cancelled);
+        }
+        let boundary = self.boundary(faces, stop_reason);
+        let mut volume = self.volume_mesh(&boundary)?;
+        volume.spacing = self.vol.take().and_then(|v| v.spacing);
+        volume.seconds_surface = seconds_surface;
+        volume.seconds_volume = start.elapsed().as_secs_f64() - seconds_surface;
+        Ok((boundary, volume))
+    }
+
+    /// Runs `refine` and extracts the boundary, fixing what breaks it, until it is a closed
+    /// 2-manifold of surface vertices (and, before the cell level, within the distance bound
+    /// of every input sample).
+    fn rounds(
+        &mut self,
+        refine: &mut dyn FnMut(&mut Self) -> Option<String>,
+    ) -> Result<(Vec<FaceRef>, Option<String>), MeshError> {
         let mut stop_reason = None;
         for _round in 0..16 {
-            stop_reason = self.refine();
+            stop_reason = refine(self);
             if let Some(e) = self.bad_spacing.take() {
                 return Err(e);
             }
@@ -362,11 +416,11 @@ impl<'a> SurfaceMesher<'a> {
                 break;
             }
             let (faces, mut problems) = self.extract();
-            if problems.is_empty() {
+            if problems.is_empty() && self.vol.is_none() {
                 problems = self.far_from_input(&faces);
-                if problems.is_empty() {
-                    return Ok(self.boundary(faces, None));
-                }
+            }
+            if problems.is_empty() {
+                return Ok((faces, None));
             }
             for (t, i) in problems {
                 if let Some(r) = self.facet_at(t, i) {
@@ -376,7 +430,7 @@ impl<'a> SurfaceMesher<'a> {
         }
         let (faces, problems) = self.extract();
         if problems.is_empty() {
-            return Ok(self.boundary(faces, stop_reason));
+            return Ok((faces, stop_reason));
         }
         Err(MeshError::InvalidInput(format!(
             "surface mode approximate: the remeshed boundary is not a closed manifold \
@@ -389,7 +443,12 @@ impl<'a> SurfaceMesher<'a> {
     /// The refinement loop: subsegments first, then the largest bad facet.
     fn refine(&mut self) -> Option<String> {
         loop {
-            if self.dt.num_vertices() > self.criteria.max_vertices.min(self.budget) {
+            let budget = if self.vol.is_some() {
+                self.criteria.max_vertices
+            } else {
+                self.criteria.max_vertices.min(self.budget)
+            };
+            if self.dt.num_vertices() > budget {
                 return Some(format!(
                     "the surface mesh reached {} vertices ({} from the samples, or \
                      max_vertices): facets that refinement cannot shape",
@@ -516,6 +575,10 @@ impl<'a> SurfaceMesher<'a> {
                 }
             }
         }
+        if self.vol.is_some() {
+            self.cells_after_insertion(self.dt.num_vertex_ids() as u32 - 1, &created);
+            return;
+        }
         for t in created {
             for i in 0..4 {
                 self.queue_face(t, i);
@@ -543,13 +606,21 @@ impl<'a> SurfaceMesher<'a> {
         if tv.contains(&INFINITE) || nv.contains(&INFINITE) {
             return None;
         }
-        let c1 = circumcenter_of(&self.dt, tv)?;
-        let c2 = circumcenter_of(&self.dt, nv)?;
+        let centre = |t: u32, tv: [u32; 4]| match self.cached_centre(t) {
+            Some(c) => c,
+            None => circumcenter_of(&self.dt, tv),
+        };
+        let c1 = centre(t, tv)?;
+        let c2 = centre(n, nv)?;
         let face = FACE[i].map(|k| tv[k]);
-        let a = self.dt.point(face[0]);
-        let best = self
-            .oracle
-            .crossings(c1, c2)
+        Self::facet_from(&self.dt, face, self.oracle.crossings(c1, c2))
+    }
+
+    /// Face `face` as a restricted facet, given where its Voronoi edge crosses the surface:
+    /// the crossing farthest from its vertices is its surface centre.
+    fn facet_from(dt: &Delaunay, face: [u32; 3], crossings: Vec<Crossing>) -> Option<Restricted> {
+        let a = dt.point(face[0]);
+        let best = crossings
             .into_iter()
             .map(|x| ((x.point - a).length(), x))
             .max_by(|x, y| x.0.total_cmp(&y.0))?;
@@ -563,7 +634,7 @@ impl<'a> SurfaceMesher<'a> {
 
     fn on_patch(&self, v: u32, patch: u32) -> bool {
         match self.loc[v as usize] {
-            Loc::Far => false,
+            Loc::Far | Loc::Volume => false,
             Loc::Patch(p) => p == patch,
             Loc::Curve(c) => self.curves.curves[c as usize].patches.contains(&patch),
             Loc::Corner(k) => self.curves.corners[k as usize].patches.contains(&patch),
@@ -598,7 +669,11 @@ impl<'a> SurfaceMesher<'a> {
         // bound at a 13-degree ridge). Its centroid's distance catches that.
         if self
             .oracle
-            .distance_beyond((a + b + c) / 3.0, self.criteria.distance)
+            .distance_beyond_hinted(
+                (a + b + c) / 3.0,
+                self.criteria.distance,
+                &mut Some(r.triangle),
+            )
             .is_some()
         {
             return Bad::Distance;
@@ -693,7 +768,9 @@ impl<'a> SurfaceMesher<'a> {
         let cap = self.dt.tet_capacity();
         let mut inside = vec![false; cap];
         for t in self.dt.finite_tet_ids() {
-            if let Some(c) = circumcenter_of(&self.dt, self.dt.tet(t)) {
+            if let Some(known) = self.is_inside(t) {
+                inside[t as usize] = known;
+            } else if let Some(c) = circumcenter_of(&self.dt, self.dt.tet(t)) {
                 inside[t as usize] = self.oracle.side(c) != Side::Outside;
             }
         }
@@ -722,9 +799,9 @@ impl<'a> SurfaceMesher<'a> {
             .filter(|&(t, i)| {
                 let tv = self.dt.tet(t);
                 let f = FACE[i].map(|k| tv[k]);
-                f.iter()
-                    .any(|&v| v == INFINITE || self.loc[v as usize] == Loc::Far)
-                    || (0..3).any(|j| edge_count[&key2(f[j], f[(j + 1) % 3])] != 2)
+                f.iter().any(|&v| {
+                    v == INFINITE || matches!(self.loc[v as usize], Loc::Far | Loc::Volume)
+                }) || (0..3).any(|j| edge_count[&key2(f[j], f[(j + 1) % 3])] != 2)
             })
             .collect();
         (faces, problems)
@@ -789,6 +866,65 @@ impl<'a> SurfaceMesher<'a> {
         edges.sort_unstable();
         out.feature_edges = edges;
         out
+    }
+}
+
+/// The tets inside the boundary, numbered with the boundary's vertices first.
+#[derive(Default)]
+pub struct VolumeMesh {
+    /// The boundary's points, then the vertices inside.
+    pub vertices: Vec<DVec3>,
+    pub tets: Vec<[u32; 4]>,
+    /// The cells' spacing when the caller gave none (graded from the surface).
+    pub spacing: Option<crate::refine::AutoSpacing>,
+    /// Time spent on the surface alone, then on the cells (with the surface refinement they
+    /// caused).
+    pub seconds_surface: f64,
+    pub seconds_volume: f64,
+}
+
+impl SurfaceMesher<'_> {
+    /// The inside tets, renumbered after `boundary` (built from the same triangulation).
+    fn volume_mesh(&self, boundary: &Boundary) -> Result<VolumeMesh, MeshError> {
+        let mut id: FxHashMap<u32, u32> = FxHashMap::default();
+        let mut vertices = boundary.points.clone();
+        // The boundary's numbering: its points are the triangulation's in first-seen order,
+        // matched back by position (they are distinct vertices).
+        let by_point: FxHashMap<[u64; 3], u32> = boundary
+            .points
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (p.to_array().map(f64::to_bits), i as u32))
+            .collect();
+        let mut tets = vec![];
+        for t in self.dt.finite_tet_ids() {
+            if self.is_inside(t) != Some(true) {
+                continue;
+            }
+            let tv = self.dt.tet(t);
+            if tv.iter().any(|&v| self.loc[v as usize] == Loc::Far) {
+                return Err(MeshError::Internal(
+                    "surface mode approximate: an inside tet reaches the far box".into(),
+                ));
+            }
+            tets.push(tv.map(|v| {
+                *id.entry(v).or_insert_with(|| {
+                    let p = self.dt.point(v);
+                    by_point
+                        .get(&p.to_array().map(f64::to_bits))
+                        .copied()
+                        .unwrap_or_else(|| {
+                            vertices.push(p);
+                            (vertices.len() - 1) as u32
+                        })
+                })
+            }));
+        }
+        Ok(VolumeMesh {
+            vertices,
+            tets,
+            ..VolumeMesh::default()
+        })
     }
 }
 

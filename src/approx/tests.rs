@@ -162,15 +162,6 @@ fn internal_facets_are_refused_in_approximate_mode() {
     assert!(e.to_string().contains("keep"), "{e}");
 }
 
-#[test]
-fn failing_facet_is_read_from_recovery_errors() {
-    assert_eq!(
-        failing_facet("facet 2317: facet edge split refused"),
-        Some(2317)
-    );
-    assert_eq!(failing_facet("boundary recovery did not terminate"), None);
-}
-
 /// Every triangulated model but the noisy elephant scan (minutes), at the defaults: completes
 /// with positive tets, the Hausdorff, feature and volume bounds (`check_mesh`), a minimum
 /// dihedral angle of at least 15 degrees (12 with a small corner) and radius-edge ratios away

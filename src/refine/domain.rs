@@ -51,23 +51,6 @@ pub struct Domain {
     pub acute_facets: FxHashSet<u32>,
     /// Per vertex: within the influence of a small input angle (see `near_acute`).
     near_small_angle: Vec<bool>,
-    /// Approximate mode only: per input segment and per input facet, the size below which a
-    /// present but encroached subsegment / subfacet is left alone (`set_small_corners`).
-    min_split_size: Option<(Vec<f64>, Vec<f64>)>,
-    /// Approximate mode only: boundary recovery (`recover::settle`) splits subsegments and
-    /// subfacets only when missing, not when present but encroached. The remeshed boundary
-    /// is restricted Delaunay, so every triangle is present already, but on a curved surface
-    /// most equatorial balls hold a neighbour: making them all empty split fandisk's 8k
-    /// boundary triangles into 40k. Refinement still splits an element its point encroaches.
-    /// Recovery stays eager within [`EAGER_REACH`] nearest-neighbour distances of a
-    /// small-angle vertex (`eager`): refinement leaves tets there that it cannot shape
-    /// without breaking the boundary, and they need a fine boundary (lazy there as well,
-    /// elephant's worst tet fell from 7.5 to 3.1 degrees).
-    pub lazy_encroachment: bool,
-    /// Under lazy encroachment: balls around the small-angle vertices (centre, squared
-    /// radius) and, per vertex, whether it lies in one (empty otherwise).
-    eager_balls: Vec<(DVec3, f64)>,
-    eager: Vec<bool>,
     /// `Params::small_angle_reach`.
     small_angle_reach: f64,
     /// Protecting balls around the acute input vertices: vertex -> radius. Inside one,
@@ -95,16 +78,8 @@ pub const SMALL_ANGLE_DEG: f64 = 60.0;
 /// other input vertex (below one half, so that the balls of two vertices never overlap).
 pub const PROTECT_FRACTION: f64 = 0.4;
 
-/// See `Domain::set_small_corners`: boundary elements of an approximated surface below this
-/// share of their input element's size are split only when missing.
-pub const MIN_SPLIT_FRACTION: f64 = 1.0 / 16.0;
-
 /// `Domain::apex` of a vertex in no protecting ball.
 pub const NO_APEX: u32 = u32::MAX;
-
-/// Radius of the balls around small-angle vertices where recovery stays eager under
-/// `Domain::lazy_encroachment`, in nearest-neighbour distances of the vertex.
-pub const EAGER_REACH: f64 = 4.0;
 
 pub fn seg_key(a: u32, b: u32) -> (u32, u32) {
     (a.min(b), a.max(b))
@@ -181,10 +156,6 @@ impl Domain {
             acute_segments: FxHashSet::default(),
             acute_facets: FxHashSet::default(),
             near_small_angle: vec![false; input.vertices.len()],
-            min_split_size: None,
-            lazy_encroachment: false,
-            eager_balls: vec![],
-            eager: vec![],
             small_angle_reach: f64::INFINITY,
             dirty_segs: vec![],
             dirty_tris: vec![],
@@ -231,49 +202,6 @@ impl Domain {
             self.acute_facets
                 .extend(self.segments[s as usize].facets.iter().copied());
         }
-        self.mark_near_small_angles();
-    }
-
-    /// The small angles of a boundary the approximate mode built: only `vertices` (its
-    /// vertices at the input's small corners) are small-angle vertices, with protecting balls;
-    /// the angles between its triangles are a remeshing's, not features.
-    ///
-    /// Its triangles are already sized to the spacing, so a boundary split far below an input
-    /// triangle's size can only be a cascade (two triangles of a curved patch whose splits
-    /// encroach each other): below [`MIN_SPLIT_FRACTION`] of its input segment or of its input
-    /// facet's shortest edge, an element is split only when missing.
-    pub fn set_small_corners(&mut self, vertices: &[u32], reach: f64, lazy: bool) {
-        self.small_angle_reach = reach;
-        let seg_len: Vec<f64> = self
-            .segments
-            .iter()
-            .map(|s| MIN_SPLIT_FRACTION * self.point(s.ends[0]).distance(self.point(s.ends[1])))
-            .collect();
-        let mut facet_edge = vec![f64::INFINITY; self.facets.len()];
-        for s in &self.segments {
-            let l = MIN_SPLIT_FRACTION * self.point(s.ends[0]).distance(self.point(s.ends[1]));
-            for &f in &s.facets {
-                facet_edge[f as usize] = facet_edge[f as usize].min(l);
-            }
-        }
-        self.min_split_size = Some((seg_len, facet_edge));
-        self.lazy_encroachment = lazy;
-        for &v in vertices {
-            let nearest = nearest_neighbor_distance(&self.dt, v);
-            self.protect_radius.insert(v, PROTECT_FRACTION * nearest);
-            self.apex[v as usize] = v;
-            self.small_angle_vertices.insert(v);
-            if lazy {
-                let r = EAGER_REACH * nearest;
-                self.eager_balls.push((self.point(v), r * r));
-            }
-        }
-        if lazy {
-            self.eager = (0..self.kind.len() as u32)
-                .map(|v| self.in_eager_ball(self.point(v)))
-                .collect();
-        }
-        self.record_facet_apexes();
         self.mark_near_small_angles();
     }
 
@@ -367,38 +295,6 @@ impl Domain {
         let a = self.apex[verts[0] as usize];
         (a != NO_APEX && verts.iter().all(|&v| self.apex[v as usize] == a))
             || self.near_acute_element(verts)
-            || self.below_min_split_size(verts)
-    }
-
-    fn in_eager_ball(&self, p: DVec3) -> bool {
-        self.eager_balls
-            .iter()
-            .any(|&(c, r2)| p.distance_squared(c) <= r2)
-    }
-
-    /// Whether recovery leaves the boundary element with vertices `verts` alone when it is
-    /// present but encroached (see `lazy_encroachment`).
-    pub fn lazily_encroached(&self, verts: &[u32]) -> bool {
-        self.lazy_encroachment && !verts.iter().any(|&v| self.eager[v as usize])
-    }
-
-    /// See `set_small_corners`.
-    fn below_min_split_size(&self, verts: &[u32]) -> bool {
-        let Some((seg_len, facet_edge)) = &self.min_split_size else {
-            return false;
-        };
-        match *verts {
-            [a, b] => self
-                .subsegs
-                .get(&seg_key(a, b))
-                .is_some_and(|&s| self.point(a).distance(self.point(b)) < seg_len[s as usize]),
-            [a, b, c] => self.subfacets.get(&tri_key([a, b, c])).is_some_and(|&f| {
-                let (pa, pb, pc) = (self.point(a), self.point(b), self.point(c));
-                let shortest = pa.distance(pb).min(pb.distance(pc)).min(pc.distance(pa));
-                shortest < facet_edge[f as usize]
-            }),
-            _ => false,
-        }
     }
 
     /// Whether a boundary element with vertices `verts` touches a feature with a small angle,
@@ -425,10 +321,6 @@ impl Domain {
                 self.apex.push(apex);
                 let near = self.is_near_small_angle(id, p, kind);
                 self.near_small_angle.push(near);
-                if !self.eager.is_empty() {
-                    let eager = self.in_eager_ball(p);
-                    self.eager.push(eager);
-                }
                 self.queue_around_last_insertion();
                 self.created_log.extend_from_slice(self.dt.last_created());
                 Ok(id)

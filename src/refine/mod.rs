@@ -429,32 +429,13 @@ pub fn mesh(
     )
 }
 
-/// [`mesh`] of a boundary the approximate mode built (`crate::approx`): its triangles meet at
-/// angles that are a remeshing's, not the input's, so only the angles at `small_corners`
-/// (its vertices at the input's real small corners) are respected. `lazy`: see
-/// `Domain::lazy_encroachment`.
-pub(crate) fn mesh_remeshed(
-    input: &PlcInput,
-    params: &Params,
-    spacing: Option<&dyn Spacing>,
-    progress: Option<Progress>,
-    small_corners: &[u32],
-    lazy: bool,
-) -> Result<(TetMesh, Report), MeshError> {
-    let angles = SmallAngles::Only(small_corners, lazy);
-    mesh_domain(input, params, spacing, progress, angles, Unseeded::Domain)
-}
-
 /// Which input angles refinement treats as small.
 #[derive(Clone, Copy)]
-enum SmallAngles<'a> {
+enum SmallAngles {
     /// Those the validator finds (keep mode).
     Input,
     /// None (the boundary of an existing mesh).
     None,
-    /// Only at these vertices (a boundary the approximate mode built), with lazy
-    /// encroachment or not.
-    Only(&'a [u32], bool),
 }
 
 /// [`mesh`], optionally treating every input angle as large (for the boundary of an existing
@@ -476,7 +457,6 @@ fn mesh_domain(
     match small_angles {
         SmallAngles::Input => dom.set_acute_angles(&plc, params.small_angle_reach),
         SmallAngles::None => {}
-        SmallAngles::Only(v, lazy) => dom.set_small_corners(v, params.small_angle_reach, lazy),
     }
     let mut budget = recover::MAX_RECOVERY_SPLITS.min(params.max_vertices.saturating_mul(4));
     dom.recover_boundary(&mut budget)?;

@@ -682,12 +682,7 @@ impl<'a> Refiner<'a> {
                 }
             }
         }
-        // Here encroached elements are split even where recovery left them (approximate
-        // mode's lazy encroachment): this tet asks for its boundary to be restored.
-        let lazy = std::mem::replace(&mut self.dom.lazy_encroachment, false);
-        let settled = self.settle_boundary();
-        self.dom.lazy_encroachment = lazy;
-        settled?;
+        self.settle_boundary()?;
         self.push_recent()?;
         Ok(self.dom.dt.num_vertices() > n_before)
     }

@@ -139,7 +139,7 @@ impl Domain {
 
     /// Inside a protecting ball an encroached element that is present is left alone.
     fn encroached_unless_protected(&self, verts: &[u32]) -> Status {
-        if self.lazily_encroached(verts) || self.protected(verts) {
+        if self.protected(verts) {
             Status::Ok
         } else {
             Status::Encroached

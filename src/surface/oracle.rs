@@ -188,32 +188,46 @@ impl<'a> SurfaceOracle<'a> {
     /// triangle within `r`: a sampled Hausdorff distance only needs the samples that raise the
     /// running maximum, and most samples lie close to the other surface.
     pub fn distance_beyond(&self, p: DVec3, r: f64) -> Option<f64> {
-        let mut stack = vec![0usize];
-        while let Some(k) = stack.pop() {
-            let Some(node) = self.nodes.get(k) else {
-                break;
-            };
+        self.distance_beyond_hinted(p, r, &mut None)
+    }
+
+    /// [`Self::distance_beyond`], trying triangle `hint` first and leaving there the triangle
+    /// found within `r` (or the nearest one): consecutive queries at nearby points mostly end
+    /// at the first test.
+    pub fn distance_beyond_hinted(&self, p: DVec3, r: f64, hint: &mut Option<u32>) -> Option<f64> {
+        let within = |t: u32| {
+            let [a, b, c] = self.surface.corners(t as usize);
+            (closest_on_triangle(p, a, b, c) - p).length() <= r
+        };
+        if hint.is_some_and(|t| (t as usize) < self.surface.triangles.len() && within(t)) {
+            return None;
+        }
+        let mut stack = [0usize; 128];
+        let mut top = usize::from(!self.nodes.is_empty());
+        while top > 0 {
+            top -= 1;
+            let node = &self.nodes[stack[top]];
             if box_distance(node, p) > r {
                 continue;
             }
             if node.count > 0 {
                 for &t in self.leaf_triangles(node) {
-                    let [a, b, c] = self.surface.corners(t as usize);
-                    if (closest_on_triangle(p, a, b, c) - p).length() <= r {
+                    if within(t) {
+                        *hint = Some(t);
                         return None;
                     }
                 }
             } else {
                 let (l, r_) = (node.first as usize, node.first as usize + 1);
                 // The nearer child last, visited first: it most likely holds a near triangle.
-                if box_distance(&self.nodes[l], p) <= box_distance(&self.nodes[r_], p) {
-                    stack.extend([r_, l]);
-                } else {
-                    stack.extend([l, r_]);
-                }
+                let near_left = box_distance(&self.nodes[l], p) <= box_distance(&self.nodes[r_], p);
+                (stack[top], stack[top + 1]) = if near_left { (r_, l) } else { (l, r_) };
+                top += 2;
             }
         }
-        self.closest(p).map(|c| c.distance)
+        let closest = self.closest(p)?;
+        *hint = Some(closest.triangle);
+        Some(closest.distance)
     }
 
     /// Every triangle the closed segment [p, q] meets, ordered by parameter then triangle id.
@@ -235,6 +249,34 @@ impl<'a> SurfaceOracle<'a> {
         });
         out.sort_by(|x, y| x.t.total_cmp(&y.t).then(x.triangle.cmp(&y.triangle)));
         out
+    }
+
+    /// [`Self::crossings`], and whether p and q lie on different sides of the closed surface
+    /// when that is clean to tell: every crossing proper (not through an edge, a vertex or
+    /// an end of the segment), else None.
+    pub fn crossings_and_parity(&self, p: DVec3, q: DVec3) -> (Vec<Crossing>, Option<bool>) {
+        let mut out = Vec::new();
+        let (mut odd, mut clean) = (false, true);
+        self.visit_segment(p, q, |t| {
+            if self.flat[t as usize] {
+                return;
+            }
+            let [a, b, c] = self.surface.corners(t as usize);
+            if segment_meets_triangle(p, q, a, b, c) {
+                let t_param = crossing_parameter(p, q, a, b, c);
+                out.push(Crossing {
+                    triangle: t,
+                    t: t_param,
+                    point: p + (q - p) * t_param,
+                });
+                match proper_crossing(p, q, a, b, c) {
+                    Crossed::Yes => odd = !odd,
+                    _ => clean = false,
+                }
+            }
+        });
+        out.sort_by(|x, y| x.t.total_cmp(&y.t).then(x.triangle.cmp(&y.triangle)));
+        (out, clean.then_some(odd))
     }
 
     /// Inside, outside or on the closed surface, by the parity of proper crossings of a ray;
@@ -286,9 +328,12 @@ impl<'a> SurfaceOracle<'a> {
         if self.nodes.is_empty() {
             return;
         }
-        let mut stack = vec![0usize];
-        while let Some(k) = stack.pop() {
-            let node = &self.nodes[k];
+        // Median splits: the depth is about log2 of the leaves, far below the stack's size.
+        let mut stack = [0usize; 128];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let node = &self.nodes[stack[top]];
             if !segment_hits_box(node, p, q) {
                 continue;
             }
@@ -297,7 +342,9 @@ impl<'a> SurfaceOracle<'a> {
                     f(t);
                 }
             } else {
-                stack.extend([node.first as usize + 1, node.first as usize]);
+                stack[top] = node.first as usize + 1;
+                stack[top + 1] = node.first as usize;
+                top += 2;
             }
         }
     }
@@ -325,7 +372,7 @@ enum Crossed {
     StartsOn,
 }
 
-/// Exact classification of segment [p, q] (q far away) against triangle (a, b, c).
+/// Exact classification of segment [p, q] against triangle (a, b, c).
 fn proper_crossing(p: DVec3, q: DVec3, a: DVec3, b: DVec3, c: DVec3) -> Crossed {
     let sign = |x: f64| crate::geom::sign(x);
     let op = sign(orient3d(a, b, c, p));

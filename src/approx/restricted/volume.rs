@@ -1,0 +1,491 @@
+//! The cell level of the restricted Delaunay mesher: once the surface is good, the tets whose
+//! circumcentres lie inside the surface are refined in the same triangulation (CGAL Mesh_3's
+//! cell level, with Li's picking ball for the refinement point).
+//!
+//! A bad cell (too large for f, radius-edge ratio over rho0, or a sliver) is refined at a point
+//! of its picking ball that creates the fewest small slivers. A point inside a restricted
+//! facet's surface ball would change the restricted surface: that facet is refined at its
+//! surface centre instead (the surface level's own rule), and a point inside a feature
+//! subsegment's diametric ball splits the subsegment. Next to a small corner cells are left as
+//! they are, as the surface is.
+//!
+//! Whether a cell is inside is known from the cell across its outer face when inserting made
+//! it: the segment between the two circumcentres crosses the surface (then a ray decides) or
+//! it does not (same side).
+
+use super::{circumcenter_of, key3, Bad, Loc, Restricted, SurfaceMesher};
+use crate::delaunay::tables::FACE;
+use crate::delaunay::{Inserted, Probe, INFINITE};
+use crate::geom::circumsphere;
+use crate::geom::screen::{shortest_edge_sq, sliver_measures};
+use crate::refine::{AutoSpacing, Spacing};
+use crate::surface::oracle::Side;
+use glam::DVec3;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rustc_hash::FxHashMap;
+use std::collections::VecDeque;
+
+/// What the cell level aims for (from `refine::Params`).
+#[derive(Debug, Clone, Copy)]
+pub struct VolumeCriteria {
+    pub rho0: f64,
+    pub sigma0: f64,
+    pub min_dihedral_deg: f64,
+    /// Picking ball radius, in circumradii.
+    pub delta: f64,
+    /// Small slivers are those with circumradius <= b times the bad cell's.
+    pub b: f64,
+    pub max_tries: usize,
+    pub size_factor: f64,
+    /// Whether f is the caller's; otherwise the cells are sized by the surface's edges,
+    /// graded inwards (as keep mode's automatic spacing).
+    pub user_spacing: bool,
+    pub seed: u64,
+}
+
+/// Cell classes, in the order they are refined (the last queue first).
+const SLIVER: usize = 0;
+const RATIO: usize = 1;
+const SIZE: usize = 2;
+
+/// Times a cell may wait for the surface or a subsegment to be refined for it before it is
+/// left as it is.
+const MAX_CELL_DEFERRALS: u8 = 4;
+
+pub(super) struct VolumeState {
+    crit: VolumeCriteria,
+    cos_min_dihedral: f64,
+    /// Per tet id: its circumcentre lies inside the surface.
+    inside: Vec<bool>,
+    /// Per tet id: its circumcentre (None: flat or infinite).
+    centre: Vec<Option<DVec3>>,
+    /// The restricted facets (sorted vertices): surface centre and surface-ball radius.
+    restricted: FxHashMap<[u32; 3], (DVec3, f64)>,
+    queues: [VecDeque<(u32, [u32; 4])>; 3],
+    deferrals: FxHashMap<[u32; 4], u8>,
+    pub(super) spacing: Option<AutoSpacing>,
+    /// The caller's progress callback asked to stop.
+    cancelled: bool,
+    rng: ChaCha8Rng,
+}
+
+/// What a refinement point would break.
+enum Encroached {
+    Nothing,
+    Facet(Restricted, u32),
+    Subsegments(Vec<[u32; 2]>),
+}
+
+impl VolumeState {
+    pub(super) fn cancelled(&self) -> bool {
+        self.cancelled
+    }
+}
+
+impl SurfaceMesher<'_> {
+    /// Starts the cell level on the current triangulation (the surface is good).
+    pub(super) fn start_volume(&mut self, crit: VolumeCriteria, faces: &[super::FaceRef]) {
+        let spacing = (!crit.user_spacing).then(|| self.surface_sizes(faces));
+        let mut inside = vec![false; self.dt.tet_capacity()];
+        let mut centre = vec![None; self.dt.tet_capacity()];
+        let mut restricted = FxHashMap::default();
+        for t in self.dt.finite_tet_ids() {
+            centre[t as usize] = circumcenter_of(&self.dt, self.dt.tet(t));
+            if let Some(c) = centre[t as usize] {
+                inside[t as usize] = self.oracle.side(c) != Side::Outside;
+            }
+            for i in 0..4 {
+                if let Some(r) = self.facet_at(t, i) {
+                    restricted.insert(key3(r.vertices), (r.centre, r.radius));
+                }
+            }
+        }
+        self.vol = Some(Box::new(VolumeState {
+            crit,
+            cos_min_dihedral: crit.min_dihedral_deg.to_radians().cos(),
+            inside,
+            centre,
+            restricted,
+            queues: Default::default(),
+            deferrals: FxHashMap::default(),
+            spacing,
+            cancelled: false,
+            rng: ChaCha8Rng::seed_from_u64(crit.seed ^ 0x766f_6c75_6d65),
+        }));
+        let tets: Vec<u32> = self.dt.finite_tet_ids().collect();
+        for t in tets {
+            self.queue_cell(t);
+        }
+    }
+
+    /// The default cell spacing: at each surface vertex the mean length of its boundary
+    /// edges, extended inwards with keep mode's grading.
+    fn surface_sizes(&self, faces: &[super::FaceRef]) -> AutoSpacing {
+        let mut sum: FxHashMap<u32, (f64, f64)> = FxHashMap::default();
+        for &(t, i) in faces {
+            let tv = self.dt.tet(t);
+            let f = FACE[i].map(|k| tv[k]);
+            for j in 0..3 {
+                let (a, b) = (f[j], f[(j + 1) % 3]);
+                let l = self.dt.point(a).distance(self.dt.point(b));
+                for v in [a, b] {
+                    let e = sum.entry(v).or_default();
+                    e.0 += l;
+                    e.1 += 1.0;
+                }
+            }
+        }
+        let mut sized: Vec<(u32, DVec3, f64)> = sum
+            .into_iter()
+            .map(|(v, (s, n))| (v, self.dt.point(v), s / n))
+            .collect();
+        sized.sort_unstable_by_key(|s| s.0);
+        let sized: Vec<(DVec3, f64)> = sized.into_iter().map(|(_, p, h)| (p, h)).collect();
+        AutoSpacing::from_sizes(&sized)
+    }
+
+    /// Whether the cell level is on, and whether tet `t` is inside the surface.
+    pub(super) fn is_inside(&self, t: u32) -> Option<bool> {
+        self.vol
+            .as_ref()
+            .map(|v| v.inside.get(t as usize).copied().unwrap_or(false))
+    }
+
+    /// After an insertion (cell level on): the restricted facets of the removed tets go; the
+    /// created tets get their circumcentre and side, their faces are checked (each Voronoi edge
+    /// crossed once) and the bad facets and cells queued.
+    pub(super) fn cells_after_insertion(&mut self, new_vertex: u32, created: &[u32]) {
+        let Some(mut vol) = self.vol.take() else {
+            return;
+        };
+        for tv in self.dt.last_removed() {
+            for f in FACE {
+                vol.restricted.remove(&key3(f.map(|k| tv[k])));
+            }
+        }
+        let cap = self.dt.tet_capacity();
+        if vol.inside.len() < cap {
+            vol.inside.resize(cap, false);
+            vol.centre.resize(cap, None);
+        }
+        for &t in created {
+            let tv = self.dt.tet(t);
+            vol.centre[t as usize] = if tv.contains(&INFINITE) {
+                None
+            } else {
+                circumcenter_of(&self.dt, tv)
+            };
+        }
+        let mut found = vec![];
+        for &t in created {
+            let tv = self.dt.tet(t);
+            let nb = self.dt.neighbors(t);
+            let c = vol.centre[t as usize];
+            for i in 0..4 {
+                let n = nb[i];
+                let outer = tv[i] == new_vertex;
+                if !outer && n < t {
+                    continue; // an inner face of the new star, seen from the other tet
+                }
+                let cn = if self.dt.tet(n).contains(&INFINITE) {
+                    None
+                } else {
+                    vol.centre[n as usize]
+                };
+                let (crossings, parity) = match (c, cn) {
+                    (Some(c), Some(cn)) => self.oracle.crossings_and_parity(c, cn),
+                    _ => (vec![], None),
+                };
+                if outer {
+                    vol.inside[t as usize] = match (c, parity) {
+                        (None, _) => false,
+                        (Some(_), Some(odd)) if cn.is_some() => vol.inside[n as usize] != odd,
+                        (Some(c), _) => self.oracle.side(c) != Side::Outside,
+                    };
+                }
+                let face = FACE[i].map(|k| tv[k]);
+                if let Some(r) = Self::facet_from(&self.dt, face, crossings) {
+                    vol.restricted
+                        .insert(key3(r.vertices), (r.centre, r.radius));
+                    found.push(r);
+                }
+            }
+        }
+        self.vol = Some(vol);
+        for r in found {
+            if self.is_bad(&r) {
+                self.facets.push(super::Queued {
+                    radius: r.radius,
+                    face: key3(r.vertices),
+                });
+            }
+        }
+        for &t in created {
+            self.queue_cell(t);
+        }
+    }
+
+    /// The circumcentre of tet `t` (cell level on; None when flat or infinite).
+    pub(super) fn cached_centre(&self, t: u32) -> Option<Option<DVec3>> {
+        self.vol
+            .as_ref()
+            .and_then(|v| v.centre.get(t as usize).copied())
+    }
+
+    fn queue_cell(&mut self, t: u32) {
+        if let Some(class) = self.cell_class(t) {
+            let tv = self.dt.tet(t);
+            if let Some(vol) = self.vol.as_mut() {
+                vol.queues[class].push_back((t, tv));
+            }
+        }
+    }
+
+    /// The class of a bad inside cell, or None when it is good, outside or next to a small
+    /// corner.
+    fn cell_class(&self, t: u32) -> Option<usize> {
+        let vol = self.vol.as_ref()?;
+        if !self.dt.is_alive(t) || !vol.inside.get(t as usize).copied().unwrap_or(false) {
+            return None;
+        }
+        let tv = self.dt.tet(t);
+        if tv.contains(&INFINITE) || tv.iter().any(|&v| self.loc[v as usize] == Loc::Far) {
+            return None;
+        }
+        let [a, b, c, d] = tv.map(|v| self.dt.point(v));
+        if [a, b, c, d].iter().any(|&p| self.near_small_corner(p)) {
+            return None;
+        }
+        let (centre, r) = circumsphere(a, b, c, d)?;
+        let f = match &vol.spacing {
+            Some(s) => s.at(centre),
+            None => self.spacing.at(centre),
+        };
+        if r > vol.crit.size_factor * f {
+            return Some(SIZE);
+        }
+        let l2 = shortest_edge_sq(a, b, c, d);
+        if r * r > vol.crit.rho0 * vol.crit.rho0 * l2 {
+            return Some(RATIO);
+        }
+        let (sigma, max_cos) = sliver_measures(a, b, c, d, l2);
+        (sigma < vol.crit.sigma0 || max_cos > vol.cos_min_dihedral).then_some(SLIVER)
+    }
+
+    /// The next bad cell still present, largest class first.
+    fn next_cell(&mut self) -> Option<u32> {
+        loop {
+            let vol = self.vol.as_mut()?;
+            let (t, tv) = vol.queues.iter_mut().rev().find_map(|q| q.pop_front())?;
+            if self.dt.is_alive(t) && self.dt.tet(t) == tv {
+                return Some(t);
+            }
+        }
+    }
+
+    /// Runs both levels until no bad facet, subsegment or cell is left (or a budget stops it).
+    pub(super) fn refine_volume(
+        &mut self,
+        progress: &mut Option<crate::refine::Progress>,
+    ) -> Option<String> {
+        let mut steps = 0usize;
+        loop {
+            steps += 1;
+            if steps % 1024 == 0 {
+                let n = self.dt.num_vertices();
+                if progress.as_mut().is_some_and(|p| !p(0.5, n)) {
+                    if let Some(vol) = self.vol.as_mut() {
+                        vol.cancelled = true;
+                    }
+                    return None;
+                }
+            }
+            if self.vol.as_ref().is_some_and(|v| v.cancelled) {
+                return None;
+            }
+            if let Some(reason) = self.refine() {
+                return Some(reason);
+            }
+            if self.bad_spacing.is_some() {
+                return None;
+            }
+            let t = self.next_cell()?;
+            if self.cell_class(t).is_some() {
+                self.refine_cell(t);
+            }
+        }
+    }
+
+    fn refine_cell(&mut self, t: u32) {
+        let tv = self.dt.tet(t);
+        let [a, b, c, d] = tv.map(|v| self.dt.point(v));
+        let Some((centre, r)) = circumsphere(a, b, c, d) else {
+            return;
+        };
+        if let Probe::Duplicate(_) = self.dt.probe(centre, Some(t)) {
+            return;
+        }
+        match self.encroached_by_cell_point(centre) {
+            Encroached::Nothing => {}
+            encroached => {
+                self.refine_encroached(t, tv, encroached);
+                return;
+            }
+        }
+        let p = self.pick_point(t, centre, r);
+        if let Ok(Inserted::New(id)) = self.dt.insert(p, Some(t)) {
+            self.loc.push(Loc::Volume);
+            debug_assert_eq!(self.loc.len(), id as usize + 1);
+            self.after_insertion();
+        }
+    }
+
+    /// The surface or a subsegment is refined for cell `t` instead of it; the cell waits (a
+    /// limited number of times: next to a refusing facet it is left).
+    fn refine_encroached(&mut self, t: u32, tv: [u32; 4], encroached: Encroached) {
+        match encroached {
+            Encroached::Nothing => return,
+            Encroached::Facet(r, hint) => self.insert_surface_point(r, hint, Bad::Size),
+            Encroached::Subsegments(keys) => {
+                for k in keys {
+                    self.force_split.insert(k);
+                    self.seg_queue.push(k);
+                }
+            }
+        }
+        let Some(vol) = self.vol.as_mut() else {
+            return;
+        };
+        let mut key = tv;
+        key.sort_unstable();
+        let n = vol.deferrals.entry(key).or_default();
+        *n += 1;
+        if *n <= MAX_CELL_DEFERRALS {
+            let class = self.cell_class(t).unwrap_or(SIZE);
+            if let Some(vol) = self.vol.as_mut() {
+                vol.queues[class].push_back((t, tv));
+            }
+        }
+    }
+
+    /// What inserting the last probed point `p` would break: a restricted facet whose surface
+    /// ball holds p (the largest), else feature subsegments whose diametric ball does.
+    fn encroached_by_cell_point(&self, p: DVec3) -> Encroached {
+        let Some(vol) = self.vol.as_ref() else {
+            return Encroached::Nothing;
+        };
+        let (cavity, _) = self.dt.probed_cavity();
+        let on_surface =
+            |v: u32| v != INFINITE && !matches!(self.loc[v as usize], Loc::Volume | Loc::Far);
+        let mut best: Option<([u32; 3], f64, u32)> = None;
+        for &t in cavity {
+            let tv = self.dt.tet(t);
+            let n_surface = tv.iter().filter(|&&v| on_surface(v)).count();
+            if n_surface < 3 {
+                continue;
+            }
+            for f in FACE {
+                let face = f.map(|k| tv[k]);
+                if !face.iter().all(|&v| on_surface(v)) {
+                    continue;
+                }
+                let key = key3(face);
+                if let Some(&(centre, radius)) = vol.restricted.get(&key) {
+                    if (p - centre).length_squared() < radius * radius
+                        && best.is_none_or(|b| radius > b.1)
+                    {
+                        best = Some((key, radius, t));
+                    }
+                }
+            }
+        }
+        if let Some((key, _, t)) = best {
+            if let Some([(ft, i), _]) = self.dt.find_face(key[0], key[1], key[2]) {
+                if let Some(r) = self.facet_at(ft, i) {
+                    return Encroached::Facet(r, t);
+                }
+            }
+        }
+        let segs = self.encroached_by_probe(p);
+        if segs.is_empty() {
+            Encroached::Nothing
+        } else {
+            Encroached::Subsegments(segs)
+        }
+    }
+
+    /// Li's choice: the circumcentre if it creates no small sliver, else the point of the
+    /// picking ball (radius delta r) creating the fewest, among those that break nothing.
+    /// The centre's cavity is the last probed on entry.
+    fn pick_point(&mut self, t: u32, centre: DVec3, r: f64) -> DVec3 {
+        let Some(crit) = self.vol.as_ref().map(|v| v.crit) else {
+            return centre;
+        };
+        let mut best = (self.small_slivers(centre, crit.b * r), centre);
+        if best.0 .0 == 0 {
+            return centre;
+        }
+        for _ in 0..crit.max_tries {
+            let q = centre + self.random_in_ball() * (crit.delta * r);
+            if let Probe::Duplicate(_) = self.dt.probe(q, Some(t)) {
+                continue;
+            }
+            let score = self.small_slivers(q, crit.b * r);
+            if score >= best.0 {
+                continue;
+            }
+            if !matches!(self.encroached_by_cell_point(q), Encroached::Nothing) {
+                continue;
+            }
+            best = (score, q);
+            if score.0 == 0 {
+                break;
+            }
+        }
+        best.1
+    }
+
+    fn random_in_ball(&mut self) -> DVec3 {
+        let Some(vol) = self.vol.as_mut() else {
+            return DVec3::ZERO;
+        };
+        loop {
+            let v = DVec3::new(
+                vol.rng.gen_range(-1.0..1.0),
+                vol.rng.gen_range(-1.0..1.0),
+                vol.rng.gen_range(-1.0..1.0),
+            );
+            if v.length_squared() <= 1.0 {
+                return v;
+            }
+        }
+    }
+
+    /// The small slivers (circumradius <= `max_r`) inserting the last probed point `p` would
+    /// create, and the largest cosine of a smallest dihedral angle among them.
+    fn small_slivers(&self, p: DVec3, max_r: f64) -> (usize, f64) {
+        let Some(vol) = self.vol.as_ref() else {
+            return (0, -1.0);
+        };
+        let (_, faces) = self.dt.probed_cavity();
+        let mut n = 0;
+        let mut worst = -1.0f64;
+        for f in faces {
+            let v = f.vertices();
+            if v.contains(&INFINITE) {
+                continue;
+            }
+            let [x, y, z] = v.map(|k| self.dt.point(k));
+            let l2 = shortest_edge_sq(x, y, z, p);
+            let (sigma, max_cos) = sliver_measures(x, y, z, p, l2);
+            if (sigma < vol.crit.sigma0 || max_cos > vol.cos_min_dihedral)
+                && circumsphere(x, y, z, p).is_none_or(|s| s.1 <= max_r)
+            {
+                n += 1;
+                worst = worst.max(max_cos);
+            }
+        }
+        (n, worst)
+    }
+}
