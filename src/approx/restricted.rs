@@ -765,15 +765,16 @@ impl<'a> SurfaceMesher<'a> {
     /// (inside tet, face index)), and those of them that break the boundary: a vertex off the
     /// surface, or an edge not shared by exactly two faces.
     fn extract(&self) -> (Vec<FaceRef>, Vec<FaceRef>) {
-        let cap = self.dt.tet_capacity();
-        let mut inside = vec![false; cap];
-        for t in self.dt.finite_tet_ids() {
-            if let Some(known) = self.is_inside(t) {
-                inside[t as usize] = known;
-            } else if let Some(c) = circumcenter_of(&self.dt, self.dt.tet(t)) {
-                inside[t as usize] = self.oracle.side(c) != Side::Outside;
+        let inside = match &self.vol {
+            Some(_) => {
+                let mut inside = vec![false; self.dt.tet_capacity()];
+                for t in self.dt.finite_tet_ids() {
+                    inside[t as usize] = self.is_inside(t) == Some(true);
+                }
+                inside
             }
-        }
+            None => self.classify_tets().inside,
+        };
         let mut faces = vec![];
         for t in self.dt.finite_tet_ids() {
             if !inside[t as usize] {
@@ -818,9 +819,14 @@ impl<'a> SurfaceMesher<'a> {
         let extracted = InputSurface::from_triangles(self.dt.points().to_vec(), triangles);
         let near = SurfaceOracle::new(&extracted);
         let points = super::measure::hausdorff_samples(self.surface);
+        // Consecutive samples come from one input triangle: the last face found is tried first.
+        let mut hint = None;
         let mut far: Vec<FaceRef> = points
             .into_iter()
-            .filter(|&p| near.distance_beyond(p, self.criteria.bound).is_some())
+            .filter(|&p| {
+                near.distance_beyond_hinted(p, self.criteria.bound, &mut hint)
+                    .is_some()
+            })
             .filter(|&p| !self.near_small_corner(p))
             .filter_map(|p| near.closest(p).map(|c| faces[c.triangle as usize]))
             .collect();
@@ -865,6 +871,71 @@ impl<'a> SurfaceMesher<'a> {
             .collect();
         edges.sort_unstable();
         out.feature_edges = edges;
+        out
+    }
+}
+
+/// Every tet's side and every restricted facet, from one pass over the triangulation.
+struct Classified {
+    /// Per tet id: its circumcentre lies inside the surface.
+    inside: Vec<bool>,
+    /// Per tet id: its circumcentre (None: flat or infinite).
+    centre: Vec<Option<DVec3>>,
+    restricted: Vec<Restricted>,
+}
+
+impl SurfaceMesher<'_> {
+    /// [`Classified`]: a walk from tet to neighbouring tet, where the segment between their
+    /// circumcentres (the face's Voronoi edge) is crossed once for both questions: it makes
+    /// the face restricted, and the parity of its proper crossings says whether the side
+    /// changes (when a crossing is not proper, or a centre is missing, a ray decides).
+    fn classify_tets(&self) -> Classified {
+        let cap = self.dt.tet_capacity();
+        let mut out = Classified {
+            inside: vec![false; cap],
+            centre: vec![None; cap],
+            restricted: vec![],
+        };
+        let mut reached = vec![false; cap];
+        let mut done = vec![false; cap];
+        let mut queue = std::collections::VecDeque::new();
+        for t in self.dt.finite_tet_ids() {
+            out.centre[t as usize] = circumcenter_of(&self.dt, self.dt.tet(t));
+            if queue.is_empty() {
+                if let Some(c) = out.centre[t as usize] {
+                    out.inside[t as usize] = self.oracle.side(c) != Side::Outside;
+                    reached[t as usize] = true;
+                    queue.push_back(t);
+                }
+            }
+        }
+        while let Some(t) = queue.pop_front() {
+            done[t as usize] = true;
+            let tv = self.dt.tet(t);
+            for (i, &n) in self.dt.neighbors(t).iter().enumerate() {
+                if done[n as usize] || !self.dt.is_finite(n) {
+                    continue;
+                }
+                let (c, cn) = (out.centre[t as usize], out.centre[n as usize]);
+                let (crossings, parity) = match (c, cn) {
+                    (Some(c), Some(cn)) => self.oracle.crossings_and_parity(c, cn),
+                    _ => (vec![], None),
+                };
+                if !reached[n as usize] {
+                    reached[n as usize] = true;
+                    out.inside[n as usize] = match (cn, parity) {
+                        (None, _) => false,
+                        (Some(_), Some(odd)) => out.inside[t as usize] != odd,
+                        (Some(cn), None) => self.oracle.side(cn) != Side::Outside,
+                    };
+                    queue.push_back(n);
+                }
+                let face = FACE[i].map(|k| tv[k]);
+                if let Some(r) = Self::facet_from(&self.dt, face, crossings) {
+                    out.restricted.push(r);
+                }
+            }
+        }
         out
     }
 }

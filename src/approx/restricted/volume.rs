@@ -87,20 +87,13 @@ impl SurfaceMesher<'_> {
     /// Starts the cell level on the current triangulation (the surface is good).
     pub(super) fn start_volume(&mut self, crit: VolumeCriteria, faces: &[super::FaceRef]) {
         let spacing = (!crit.user_spacing).then(|| self.surface_sizes(faces));
-        let mut inside = vec![false; self.dt.tet_capacity()];
-        let mut centre = vec![None; self.dt.tet_capacity()];
-        let mut restricted = FxHashMap::default();
-        for t in self.dt.finite_tet_ids() {
-            centre[t as usize] = circumcenter_of(&self.dt, self.dt.tet(t));
-            if let Some(c) = centre[t as usize] {
-                inside[t as usize] = self.oracle.side(c) != Side::Outside;
-            }
-            for i in 0..4 {
-                if let Some(r) = self.facet_at(t, i) {
-                    restricted.insert(key3(r.vertices), (r.centre, r.radius));
-                }
-            }
-        }
+        let classified = self.classify_tets();
+        let restricted = classified
+            .restricted
+            .iter()
+            .map(|r| (key3(r.vertices), (r.centre, r.radius)))
+            .collect();
+        let (inside, centre) = (classified.inside, classified.centre);
         self.vol = Some(Box::new(VolumeState {
             crit,
             cos_min_dihedral: crit.min_dihedral_deg.to_radians().cos(),
