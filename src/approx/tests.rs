@@ -55,6 +55,31 @@ fn check_mesh(name: &str, size: Option<f64>) -> (TetMesh, Report) {
             "{name}: tet {k} not positive"
         );
     }
+    // The boundary triangles are exactly the tet faces with one tet, each facing out of it.
+    let mut once: std::collections::HashMap<[u32; 3], u32> = Default::default();
+    for t in &mesh.tets {
+        for f in crate::delaunay::tables::FACE {
+            let mut key = f.map(|k| t[k]);
+            key.sort_unstable();
+            *once.entry(key).or_default() += 1;
+        }
+    }
+    let mut open: Vec<[u32; 3]> = once.into_iter().filter(|e| e.1 == 1).map(|e| e.0).collect();
+    let mut boundary: Vec<[u32; 3]> = mesh
+        .boundary
+        .iter()
+        .map(|b| {
+            let mut key = *b;
+            key.sort_unstable();
+            key
+        })
+        .collect();
+    open.sort_unstable();
+    boundary.sort_unstable();
+    assert_eq!(
+        open, boundary,
+        "{name}: boundary triangles are not the open tet faces"
+    );
     let s = report
         .surface
         .clone()
@@ -162,12 +187,11 @@ fn internal_facets_are_refused_in_approximate_mode() {
     assert!(e.to_string().contains("keep"), "{e}");
 }
 
-/// Every triangulated model but the noisy elephant scan (minutes), at the defaults: completes
+/// Every triangulated model, the noisy elephant scan included, at the defaults: completes
 /// with positive tets, the Hausdorff, feature and volume bounds (`check_mesh`), a minimum
 /// dihedral angle of at least 15 degrees (12 with a small corner) and radius-edge ratios away
-/// from small corners at most 2 (2.05 here: rotor leaves one tet at 2.02, docs/approximate.md).
-/// joint ran for ever before the refinement stopped drawing points from flat tets' noise
-/// spheres. Release builds only (about a minute; ten in a debug build).
+/// from small corners at most 2. Release builds only (about half a minute; minutes in a
+/// debug build).
 #[test]
 fn models_meet_the_bounds_at_the_defaults() {
     if cfg!(debug_assertions) {
@@ -176,6 +200,7 @@ fn models_meet_the_bounds_at_the_defaults() {
     }
     let models = [
         "cube", "cross", "star", "oblong", "part", "rotor", "spool", "anchor", "fandisk", "joint",
+        "elephant",
     ];
     for name in models {
         let path = format!("off/{name}.off");
@@ -189,7 +214,7 @@ fn models_meet_the_bounds_at_the_defaults() {
             q.min_dihedral_deg
         );
         assert!(
-            s.max_rho_away_from_small_corners <= 2.05,
+            s.max_rho_away_from_small_corners <= 2.0,
             "{name}: max rho away from small corners {}",
             s.max_rho_away_from_small_corners
         );
