@@ -8,8 +8,9 @@
 //! 3. a new boundary: the restricted Delaunay surface of samples of the input, refined for
 //!    topology, size f, facet angle and the distance bound, with the feature curves protected
 //!    (`restricted`);
-//! 4. the volume inside that boundary meshed by REMOVE-SLIVER (`refine::mesh_remeshed`, the
-//!    new triangles as facets, one marker per patch or input label), then improved;
+//! 4. the cells inside refined in the same triangulation (`restricted::volume`: Li's picking
+//!    ball; a point in a restricted facet's surface ball refines that facet instead), the
+//!    boundary faces marked per patch or input label, then improved;
 //! 5. the report's surface figures measured on the written boundary (`measure`).
 
 mod curves;
@@ -113,8 +114,7 @@ fn mesh_restricted(
         seed: params.seed,
     };
     let start = std::time::Instant::now();
-    let (mut remeshed, volume) = remesh(input, params, spacing, Some((crit, progress)))?;
-    let volume = volume.ok_or_else(|| MeshError::Internal("no volume".into()))?;
+    let (mut remeshed, volume) = remesh(input, params, spacing, crit, progress)?;
     remeshed.seconds -= volume.seconds_volume;
     let attribute = input.regions.first().map_or(0, |r| r.attribute);
     let mesh = TetMesh {
@@ -159,13 +159,14 @@ fn mesh_restricted(
     Ok((remeshed, mesh, report))
 }
 
-/// Steps 1-3: the new boundary.
+/// Steps 1-4: the new boundary and the tets inside it.
 pub fn remesh(
     input: &PlcInput,
     params: &Params,
     spacing: Option<&dyn Spacing>,
-    volume: Option<(VolumeCriteria, Option<Progress>)>,
-) -> Result<(Remeshed, Option<VolumeMesh>), MeshError> {
+    crit: VolumeCriteria,
+    progress: Option<Progress>,
+) -> Result<(Remeshed, VolumeMesh), MeshError> {
     let start = std::time::Instant::now();
     params.check().map_err(MeshError::InvalidInput)?;
     let plc = crate::plc::validate(input).map_err(|e| MeshError::InvalidInput(e.to_string()))?;
@@ -208,13 +209,7 @@ pub fn remesh(
         seed: params.seed,
     };
     let mesher = SurfaceMesher::new(&surface, &oracle, &curves, &features.patch_of, f, criteria)?;
-    let (b, volume) = match volume {
-        Some((crit, progress)) => {
-            let (b, v) = mesher.run_with_volume(crit, progress)?;
-            (b, Some(v))
-        }
-        None => (mesher.run()?, None),
-    };
+    let (b, volume) = mesher.run_with_volume(crit, progress)?;
     let labels = has_labels(input);
     let facets = b
         .triangles
@@ -240,21 +235,14 @@ pub fn remesh(
         .small_corners()
         .map(|c| (c.point, c.protect_radius))
         .collect();
-    // Every vertex in a small corner's protecting ball, where the surface mesher left facet
-    // angles alone: the volume refinement protects them too (thin boundary triangles there
-    // would make it split without end).
-    //
-    // Likewise every vertex where two boundary edges meet below the facet angle bound (a
-    // saddle of a scan where non-adjacent triangles fold close): measured on elephant, such
-    // a vertex made boundary recovery split its edges at concentric shells without end.
-    let narrow = narrow_vertices(&b);
+    // The boundary vertices in a small corner's protecting ball, where the surface mesher left
+    // facet angles alone and the cells are not refined (the report counts them).
     let small_corner_vertices = (0..b.loc.len() as u32)
         .filter(|&v| {
             let p = b.points[v as usize];
-            narrow[v as usize]
-                || curves
-                    .small_corners()
-                    .any(|c| (p - c.point).length_squared() <= c.protect_radius * c.protect_radius)
+            curves
+                .small_corners()
+                .any(|c| (p - c.point).length_squared() <= c.protect_radius * c.protect_radius)
         })
         .collect();
     let remeshed = Remeshed {
@@ -281,38 +269,4 @@ fn has_labels(input: &PlcInput) -> bool {
         .iter()
         .enumerate()
         .all(|(i, f)| f.marker as i64 == i as i64 + 1)
-}
-
-/// Below this angle between two of its boundary edges (any two, adjacent or not) a vertex of
-/// the new boundary is treated as a small angle by the volume refinement; just below the
-/// facet angle bound, so only vertices the facet criteria could not shape are.
-const NARROW_EDGE_ANGLE_DEG: f64 = 29.0;
-
-/// Per boundary vertex: two of its edges meet below [`NARROW_EDGE_ANGLE_DEG`].
-fn narrow_vertices(b: &restricted::Boundary) -> Vec<bool> {
-    let mut neighbours: Vec<Vec<u32>> = vec![vec![]; b.points.len()];
-    for t in &b.triangles {
-        for j in 0..3 {
-            let (x, y) = (t[j], t[(j + 1) % 3]);
-            neighbours[x as usize].push(y);
-            neighbours[y as usize].push(x);
-        }
-    }
-    let cos_narrow = NARROW_EDGE_ANGLE_DEG.to_radians().cos();
-    neighbours
-        .iter_mut()
-        .enumerate()
-        .map(|(v, nb)| {
-            nb.sort_unstable();
-            nb.dedup();
-            let p = b.points[v];
-            let dirs: Vec<glam::DVec3> = nb
-                .iter()
-                .map(|&w| (b.points[w as usize] - p).normalize_or_zero())
-                .collect();
-            dirs.iter()
-                .enumerate()
-                .any(|(i, u)| dirs[i + 1..].iter().any(|w| u.dot(*w) > cos_narrow))
-        })
-        .collect()
 }

@@ -357,16 +357,9 @@ impl<'a> SurfaceMesher<'a> {
         }
     }
 
-    /// Refines until every restricted facet is good (or a budget or small corner stops it),
-    /// then extracts the boundary; repeats while the boundary is not a closed 2-manifold of
-    /// surface vertices.
-    pub fn run(mut self) -> Result<Boundary, MeshError> {
-        let (faces, stop_reason) = self.rounds(&mut Self::refine)?;
-        Ok(self.boundary(faces, stop_reason))
-    }
-
-    /// [`Self::run`], then the cell level (`volume`) in the same triangulation: the boundary
-    /// and the tets inside it.
+    /// Refines the surface until every restricted facet is good, then the cells (`volume`) in
+    /// the same triangulation; after each, extracts the boundary and repeats while it is not a
+    /// closed 2-manifold of surface vertices. Returns the boundary and the tets inside it.
     pub fn run_with_volume(
         mut self,
         crit: VolumeCriteria,
