@@ -19,6 +19,7 @@
 //! farther than the distance bound from its surface centre. Bad facets are refined largest
 //! first, each at its surface centre.
 
+mod tracking;
 mod volume;
 
 pub use volume::VolumeCriteria;
@@ -28,7 +29,7 @@ use crate::delaunay::tables::FACE;
 use crate::delaunay::{Delaunay, Inserted, INFINITE};
 use crate::geom::{circumcenter, tri_circumcenter};
 use crate::refine::{MeshError, Spacing};
-use crate::surface::oracle::{Crossing, Side, SurfaceOracle};
+use crate::surface::oracle::{Crossing, SurfaceOracle};
 use crate::surface::InputSurface;
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
@@ -160,6 +161,8 @@ pub struct SurfaceMesher<'a> {
     deferrals: FxHashMap<[u32; 3], u32>,
     bad_spacing: Option<MeshError>,
     min_length: f64,
+    /// Sides, circumcentres and restricted facets, kept up to date (`tracking`).
+    track: tracking::Tracking,
     /// The cell level, once the surface is good (`run_with_volume`).
     vol: Option<Box<volume::VolumeState>>,
 }
@@ -219,6 +222,7 @@ impl<'a> SurfaceMesher<'a> {
             deferrals: FxHashMap::default(),
             bad_spacing: None,
             min_length: 1e-9 * diagonal,
+            track: tracking::Tracking::default(),
             vol: None,
         };
         let mut points = far_box(surface, diagonal);
@@ -246,12 +250,7 @@ impl<'a> SurfaceMesher<'a> {
             keys.reverse();
             keys
         };
-        let tets: Vec<u32> = m.dt.finite_tet_ids().collect();
-        for t in tets {
-            for i in 0..4 {
-                m.queue_face(t, i);
-            }
-        }
+        m.start_tracking();
         Ok(m)
     }
 
@@ -568,26 +567,8 @@ impl<'a> SurfaceMesher<'a> {
                 }
             }
         }
-        if self.vol.is_some() {
-            self.cells_after_insertion(self.dt.num_vertex_ids() as u32 - 1, &created);
-            return;
-        }
-        for t in created {
-            for i in 0..4 {
-                self.queue_face(t, i);
-            }
-        }
-    }
-
-    fn queue_face(&mut self, t: u32, i: usize) {
-        if let Some(r) = self.facet_at(t, i) {
-            if self.is_bad(&r) {
-                self.facets.push(Queued {
-                    radius: r.radius,
-                    face: key3(r.vertices),
-                });
-            }
-        }
+        self.track_insertion(self.dt.num_vertex_ids() as u32 - 1, &created);
+        self.queue_cells(&created);
     }
 
     /// Face `i` of tet `t` if its Voronoi edge crosses the surface, with the crossing farthest
@@ -599,12 +580,8 @@ impl<'a> SurfaceMesher<'a> {
         if tv.contains(&INFINITE) || nv.contains(&INFINITE) {
             return None;
         }
-        let centre = |t: u32, tv: [u32; 4]| match self.cached_centre(t) {
-            Some(c) => c,
-            None => circumcenter_of(&self.dt, tv),
-        };
-        let c1 = centre(t, tv)?;
-        let c2 = centre(n, nv)?;
+        let c1 = self.centre_of(t)?;
+        let c2 = self.centre_of(n)?;
         let face = FACE[i].map(|k| tv[k]);
         Self::facet_from(&self.dt, face, self.oracle.crossings(c1, c2))
     }
@@ -758,16 +735,10 @@ impl<'a> SurfaceMesher<'a> {
     /// (inside tet, face index)), and those of them that break the boundary: a vertex off the
     /// surface, or an edge not shared by exactly two faces.
     fn extract(&self) -> (Vec<FaceRef>, Vec<FaceRef>) {
-        let inside = match &self.vol {
-            Some(_) => {
-                let mut inside = vec![false; self.dt.tet_capacity()];
-                for t in self.dt.finite_tet_ids() {
-                    inside[t as usize] = self.is_inside(t) == Some(true);
-                }
-                inside
-            }
-            None => self.classify_tets().inside,
-        };
+        let mut inside = vec![false; self.dt.tet_capacity()];
+        for t in self.dt.finite_tet_ids() {
+            inside[t as usize] = self.is_inside(t);
+        }
         let mut faces = vec![];
         for t in self.dt.finite_tet_ids() {
             if !inside[t as usize] {
@@ -868,71 +839,6 @@ impl<'a> SurfaceMesher<'a> {
     }
 }
 
-/// Every tet's side and every restricted facet, from one pass over the triangulation.
-struct Classified {
-    /// Per tet id: its circumcentre lies inside the surface.
-    inside: Vec<bool>,
-    /// Per tet id: its circumcentre (None: flat or infinite).
-    centre: Vec<Option<DVec3>>,
-    restricted: Vec<Restricted>,
-}
-
-impl SurfaceMesher<'_> {
-    /// [`Classified`]: a walk from tet to neighbouring tet, where the segment between their
-    /// circumcentres (the face's Voronoi edge) is crossed once for both questions: it makes
-    /// the face restricted, and the parity of its proper crossings says whether the side
-    /// changes (when a crossing is not proper, or a centre is missing, a ray decides).
-    fn classify_tets(&self) -> Classified {
-        let cap = self.dt.tet_capacity();
-        let mut out = Classified {
-            inside: vec![false; cap],
-            centre: vec![None; cap],
-            restricted: vec![],
-        };
-        let mut reached = vec![false; cap];
-        let mut done = vec![false; cap];
-        let mut queue = std::collections::VecDeque::new();
-        for t in self.dt.finite_tet_ids() {
-            out.centre[t as usize] = circumcenter_of(&self.dt, self.dt.tet(t));
-            if queue.is_empty() {
-                if let Some(c) = out.centre[t as usize] {
-                    out.inside[t as usize] = self.oracle.side(c) != Side::Outside;
-                    reached[t as usize] = true;
-                    queue.push_back(t);
-                }
-            }
-        }
-        while let Some(t) = queue.pop_front() {
-            done[t as usize] = true;
-            let tv = self.dt.tet(t);
-            for (i, &n) in self.dt.neighbors(t).iter().enumerate() {
-                if done[n as usize] || !self.dt.is_finite(n) {
-                    continue;
-                }
-                let (c, cn) = (out.centre[t as usize], out.centre[n as usize]);
-                let (crossings, parity) = match (c, cn) {
-                    (Some(c), Some(cn)) => self.oracle.crossings_and_parity(c, cn),
-                    _ => (vec![], None),
-                };
-                if !reached[n as usize] {
-                    reached[n as usize] = true;
-                    out.inside[n as usize] = match (cn, parity) {
-                        (None, _) => false,
-                        (Some(_), Some(odd)) => out.inside[t as usize] != odd,
-                        (Some(cn), None) => self.oracle.side(cn) != Side::Outside,
-                    };
-                    queue.push_back(n);
-                }
-                let face = FACE[i].map(|k| tv[k]);
-                if let Some(r) = Self::facet_from(&self.dt, face, crossings) {
-                    out.restricted.push(r);
-                }
-            }
-        }
-        out
-    }
-}
-
 /// The tets inside the boundary, numbered with the boundary's vertices first.
 #[derive(Default)]
 pub struct VolumeMesh {
@@ -962,7 +868,7 @@ impl SurfaceMesher<'_> {
             .collect();
         let mut tets = vec![];
         for t in self.dt.finite_tet_ids() {
-            if self.is_inside(t) != Some(true) {
+            if !self.is_inside(t) {
                 continue;
             }
             let tv = self.dt.tet(t);

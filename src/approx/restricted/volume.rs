@@ -9,17 +9,14 @@
 //! subsegment's diametric ball splits the subsegment. Next to a small corner cells are left as
 //! they are, as the surface is.
 //!
-//! Whether a cell is inside is known from the cell across its outer face when inserting made
-//! it: the segment between the two circumcentres crosses the surface (then a ray decides) or
-//! it does not (same side).
+//! Which cells are inside and which facets are restricted is kept up to date by `tracking`.
 
-use super::{circumcenter_of, key3, Bad, Loc, Restricted, SurfaceMesher};
+use super::{key3, Bad, Loc, Restricted, SurfaceMesher};
 use crate::delaunay::tables::FACE;
 use crate::delaunay::{Inserted, Probe, INFINITE};
 use crate::geom::circumsphere;
 use crate::geom::screen::{shortest_edge_sq, sliver_measures};
 use crate::refine::{AutoSpacing, Spacing};
-use crate::surface::oracle::Side;
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -56,12 +53,6 @@ const MAX_CELL_DEFERRALS: u8 = 4;
 pub(super) struct VolumeState {
     crit: VolumeCriteria,
     cos_min_dihedral: f64,
-    /// Per tet id: its circumcentre lies inside the surface.
-    inside: Vec<bool>,
-    /// Per tet id: its circumcentre (None: flat or infinite).
-    centre: Vec<Option<DVec3>>,
-    /// The restricted facets (sorted vertices): surface centre and surface-ball radius.
-    restricted: FxHashMap<[u32; 3], (DVec3, f64)>,
     queues: [VecDeque<(u32, [u32; 4])>; 3],
     deferrals: FxHashMap<[u32; 4], u8>,
     pub(super) spacing: Option<AutoSpacing>,
@@ -87,19 +78,9 @@ impl SurfaceMesher<'_> {
     /// Starts the cell level on the current triangulation (the surface is good).
     pub(super) fn start_volume(&mut self, crit: VolumeCriteria, faces: &[super::FaceRef]) {
         let spacing = (!crit.user_spacing).then(|| self.surface_sizes(faces));
-        let classified = self.classify_tets();
-        let restricted = classified
-            .restricted
-            .iter()
-            .map(|r| (key3(r.vertices), (r.centre, r.radius)))
-            .collect();
-        let (inside, centre) = (classified.inside, classified.centre);
         self.vol = Some(Box::new(VolumeState {
             crit,
             cos_min_dihedral: crit.min_dihedral_deg.to_radians().cos(),
-            inside,
-            centre,
-            restricted,
             queues: Default::default(),
             deferrals: FxHashMap::default(),
             spacing,
@@ -138,92 +119,13 @@ impl SurfaceMesher<'_> {
         AutoSpacing::from_sizes(&sized)
     }
 
-    /// Whether the cell level is on, and whether tet `t` is inside the surface.
-    pub(super) fn is_inside(&self, t: u32) -> Option<bool> {
-        self.vol
-            .as_ref()
-            .map(|v| v.inside.get(t as usize).copied().unwrap_or(false))
-    }
-
-    /// After an insertion (cell level on): the restricted facets of the removed tets go; the
-    /// created tets get their circumcentre and side, their faces are checked (each Voronoi edge
-    /// crossed once) and the bad facets and cells queued.
-    pub(super) fn cells_after_insertion(&mut self, new_vertex: u32, created: &[u32]) {
-        let Some(mut vol) = self.vol.take() else {
-            return;
-        };
-        for tv in self.dt.last_removed() {
-            for f in FACE {
-                vol.restricted.remove(&key3(f.map(|k| tv[k])));
+    /// After an insertion (cell level on): the created tets are queued when bad.
+    pub(super) fn queue_cells(&mut self, created: &[u32]) {
+        if self.vol.is_some() {
+            for &t in created {
+                self.queue_cell(t);
             }
         }
-        let cap = self.dt.tet_capacity();
-        if vol.inside.len() < cap {
-            vol.inside.resize(cap, false);
-            vol.centre.resize(cap, None);
-        }
-        for &t in created {
-            let tv = self.dt.tet(t);
-            vol.centre[t as usize] = if tv.contains(&INFINITE) {
-                None
-            } else {
-                circumcenter_of(&self.dt, tv)
-            };
-        }
-        let mut found = vec![];
-        for &t in created {
-            let tv = self.dt.tet(t);
-            let nb = self.dt.neighbors(t);
-            let c = vol.centre[t as usize];
-            for i in 0..4 {
-                let n = nb[i];
-                let outer = tv[i] == new_vertex;
-                if !outer && n < t {
-                    continue; // an inner face of the new star, seen from the other tet
-                }
-                let cn = if self.dt.tet(n).contains(&INFINITE) {
-                    None
-                } else {
-                    vol.centre[n as usize]
-                };
-                let (crossings, parity) = match (c, cn) {
-                    (Some(c), Some(cn)) => self.oracle.crossings_and_parity(c, cn),
-                    _ => (vec![], None),
-                };
-                if outer {
-                    vol.inside[t as usize] = match (c, parity) {
-                        (None, _) => false,
-                        (Some(_), Some(odd)) if cn.is_some() => vol.inside[n as usize] != odd,
-                        (Some(c), _) => self.oracle.side(c) != Side::Outside,
-                    };
-                }
-                let face = FACE[i].map(|k| tv[k]);
-                if let Some(r) = Self::facet_from(&self.dt, face, crossings) {
-                    vol.restricted
-                        .insert(key3(r.vertices), (r.centre, r.radius));
-                    found.push(r);
-                }
-            }
-        }
-        self.vol = Some(vol);
-        for r in found {
-            if self.is_bad(&r) {
-                self.facets.push(super::Queued {
-                    radius: r.radius,
-                    face: key3(r.vertices),
-                });
-            }
-        }
-        for &t in created {
-            self.queue_cell(t);
-        }
-    }
-
-    /// The circumcentre of tet `t` (cell level on; None when flat or infinite).
-    pub(super) fn cached_centre(&self, t: u32) -> Option<Option<DVec3>> {
-        self.vol
-            .as_ref()
-            .and_then(|v| v.centre.get(t as usize).copied())
     }
 
     fn queue_cell(&mut self, t: u32) {
@@ -239,7 +141,7 @@ impl SurfaceMesher<'_> {
     /// corner.
     fn cell_class(&self, t: u32) -> Option<usize> {
         let vol = self.vol.as_ref()?;
-        if !self.dt.is_alive(t) || !vol.inside.get(t as usize).copied().unwrap_or(false) {
+        if !self.dt.is_alive(t) || !self.is_inside(t) {
             return None;
         }
         let tv = self.dt.tet(t);
@@ -365,9 +267,9 @@ impl SurfaceMesher<'_> {
     /// What inserting the last probed point `p` would break: a restricted facet whose surface
     /// ball holds p (the largest), else feature subsegments whose diametric ball does.
     fn encroached_by_cell_point(&self, p: DVec3) -> Encroached {
-        let Some(vol) = self.vol.as_ref() else {
+        if self.vol.is_none() {
             return Encroached::Nothing;
-        };
+        }
         let (cavity, _) = self.dt.probed_cavity();
         let on_surface =
             |v: u32| v != INFINITE && !matches!(self.loc[v as usize], Loc::Volume | Loc::Far);
@@ -384,7 +286,7 @@ impl SurfaceMesher<'_> {
                     continue;
                 }
                 let key = key3(face);
-                if let Some(&(centre, radius)) = vol.restricted.get(&key) {
+                if let Some(&(centre, radius)) = self.track.restricted.get(&key) {
                     if (p - centre).length_squared() < radius * radius
                         && best.is_none_or(|b| radius > b.1)
                     {
