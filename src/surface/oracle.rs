@@ -12,8 +12,23 @@ use crate::plc::exact::{point_in_triangle_3d, segment_meets_triangle};
 use glam::DVec3;
 use std::cmp::Ordering;
 
-/// Triangles per leaf.
+/// Pieces per leaf.
 const LEAF_SIZE: usize = 4;
+
+/// Triangles are cut (longest edge halved) into pieces no longer than this share of the
+/// bounding-box diagonal, at most [`MAX_PIECES`] each, and the tree is built over the pieces'
+/// boxes: one box around a long thin CAD strip would cover much of the model, and every query
+/// near it would test the triangle (measured on joint: 16 exact tests per segment query).
+const PIECE_FRACTION: f64 = 1.0 / 64.0;
+const MAX_PIECES: usize = 64;
+
+/// A piece of a triangle: only its box is kept; queries test the whole triangle.
+#[derive(Debug, Clone, Copy)]
+struct Piece {
+    triangle: u32,
+    lo: DVec3,
+    hi: DVec3,
+}
 
 #[derive(Debug, Clone, Copy)]
 struct Node {
@@ -54,7 +69,12 @@ pub enum Side {
 pub struct SurfaceOracle<'a> {
     surface: &'a InputSurface,
     nodes: Vec<Node>,
+    pieces: Vec<Piece>,
+    /// Piece ids in leaf order.
     order: Vec<u32>,
+    /// Per leaf position in `order`: the piece's triangle.
+    leaf_tri: Vec<u32>,
+    grid: Occupancy,
     /// Triangles with three collinear corners take no part in exact queries.
     flat: Vec<bool>,
     pad: f64,
@@ -65,35 +85,38 @@ impl<'a> SurfaceOracle<'a> {
     pub fn new(surface: &'a InputSurface) -> SurfaceOracle<'a> {
         let n = surface.triangles.len();
         let diagonal = surface.bbox_diagonal();
+        let pieces = cut_into_pieces(surface, PIECE_FRACTION * diagonal);
         let mut o = SurfaceOracle {
             surface,
-            nodes: Vec::with_capacity(2 * n / LEAF_SIZE + 1),
-            order: (0..n as u32).collect(),
+            nodes: Vec::with_capacity(2 * pieces.len() / LEAF_SIZE + 1),
+            order: (0..pieces.len() as u32).collect(),
+            leaf_tri: vec![],
+            grid: Occupancy::new(&pieces, PIECE_FRACTION * diagonal),
+            pieces,
             flat: (0..n).map(|t| is_flat(surface.corners(t))).collect(),
             pad: 1e-9 * diagonal.max(f64::MIN_POSITIVE),
             diagonal,
         };
-        let centroids: Vec<DVec3> = (0..n)
-            .map(|t| {
-                let [a, b, c] = surface.corners(t);
-                (a + b + c) / 3.0
-            })
-            .collect();
-        if n > 0 {
-            o.nodes.push(o.leaf(0, n));
+        let centroids: Vec<DVec3> = o.pieces.iter().map(|p| (p.lo + p.hi) / 2.0).collect();
+        let m = o.pieces.len();
+        if m > 0 {
+            o.nodes.push(o.leaf(0, m));
             o.split(0, &centroids);
         }
+        o.leaf_tri = o
+            .order
+            .iter()
+            .map(|&k| o.pieces[k as usize].triangle)
+            .collect();
         o
     }
 
     fn leaf(&self, first: usize, count: usize) -> Node {
         let mut lo = DVec3::splat(f64::INFINITY);
         let mut hi = DVec3::splat(f64::NEG_INFINITY);
-        for &t in &self.order[first..first + count] {
-            for p in self.surface.corners(t as usize) {
-                lo = lo.min(p);
-                hi = hi.max(p);
-            }
+        for &k in &self.order[first..first + count] {
+            lo = lo.min(self.pieces[k as usize].lo);
+            hi = hi.max(self.pieces[k as usize].hi);
         }
         Node {
             lo: lo - DVec3::splat(self.pad),
@@ -138,8 +161,9 @@ impl<'a> SurfaceOracle<'a> {
         }
     }
 
+    /// The triangles of a leaf's pieces (a triangle may come up again in another leaf).
     fn leaf_triangles(&self, node: &Node) -> &[u32] {
-        &self.order[node.first as usize..(node.first + node.count) as usize]
+        &self.leaf_tri[node.first as usize..(node.first + node.count) as usize]
     }
 
     /// The surface point nearest to `p` (ties: the lowest triangle id found first).
@@ -323,23 +347,30 @@ impl<'a> SurfaceOracle<'a> {
         }
     }
 
-    /// Calls `f` with every triangle whose box the segment [p, q] may touch.
+    /// Calls `f` once with every triangle a piece box of which the segment [p, q] may touch.
     fn visit_segment(&self, p: DVec3, q: DVec3, mut f: impl FnMut(u32)) {
         if self.nodes.is_empty() {
             return;
         }
+        if self.grid.surely_clear(p, q) {
+            return;
+        }
+        let slab = Slab::new(p, q);
+        let mut seen = SeenTriangles::default();
         // Median splits: the depth is about log2 of the leaves, far below the stack's size.
         let mut stack = [0usize; 128];
         let mut top = 1;
         while top > 0 {
             top -= 1;
             let node = &self.nodes[stack[top]];
-            if !segment_hits_box(node, p, q) {
+            if !segment_hits_box(node, &slab) {
                 continue;
             }
             if node.count > 0 {
                 for &t in self.leaf_triangles(node) {
-                    f(t);
+                    if seen.insert(t) {
+                        f(t);
+                    }
                 }
             } else {
                 stack[top] = node.first as usize + 1;
@@ -351,6 +382,190 @@ impl<'a> SurfaceOracle<'a> {
 }
 
 struct OnSurface;
+
+/// The triangles one segment query has handed out (pieces of a triangle share its tests).
+#[derive(Default)]
+struct SeenTriangles {
+    first: [u32; 16],
+    n: usize,
+    more: Vec<u32>,
+}
+
+impl SeenTriangles {
+    /// Whether `t` is new (and records it).
+    fn insert(&mut self, t: u32) -> bool {
+        let n = self.n.min(self.first.len());
+        if self.first[..n].contains(&t) || self.more.contains(&t) {
+            return false;
+        }
+        if self.n < self.first.len() {
+            self.first[self.n] = t;
+        } else {
+            self.more.push(t);
+        }
+        self.n += 1;
+        true
+    }
+}
+
+/// Which cells of a uniform grid a piece box touches: a short segment whose box touches none
+/// meets no triangle, answered without walking the tree (most Voronoi edges of a volume mesh
+/// lie far from the surface).
+struct Occupancy {
+    origin: DVec3,
+    cell: f64,
+    dims: [usize; 3],
+    bits: Vec<u64>,
+}
+
+/// Segments whose box spans more cells than this along an axis walk the tree directly.
+const GRID_SPAN: usize = 3;
+
+impl Occupancy {
+    fn new(pieces: &[Piece], cell: f64) -> Occupancy {
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        for p in pieces {
+            lo = lo.min(p.lo);
+            hi = hi.max(p.hi);
+        }
+        if pieces.is_empty() || cell.is_nan() || cell <= 0.0 {
+            return Occupancy {
+                origin: DVec3::ZERO,
+                cell: 1.0,
+                dims: [0; 3],
+                bits: vec![],
+            };
+        }
+        // One cell of margin on each side, so that rounding at the box never matters.
+        let origin = lo - DVec3::splat(cell);
+        let dims = ((hi - origin) / cell)
+            .to_array()
+            .map(|x| (x.ceil() as usize + 2).min(256));
+        let cell = ((hi - origin)
+            / DVec3::new(
+                dims[0] as f64 - 1.0,
+                dims[1] as f64 - 1.0,
+                dims[2] as f64 - 1.0,
+            ))
+        .max_element()
+        .max(cell);
+        let mut g = Occupancy {
+            origin,
+            cell,
+            dims,
+            bits: vec![0; (dims[0] * dims[1] * dims[2]).div_ceil(64)],
+        };
+        for p in pieces {
+            let (a, b) = (g.index(p.lo, -1), g.index(p.hi, 1));
+            for k in a[2]..=b[2] {
+                for j in a[1]..=b[1] {
+                    for i in a[0]..=b[0] {
+                        let c = (k * dims[1] + j) * dims[0] + i;
+                        g.bits[c / 64] |= 1 << (c % 64);
+                    }
+                }
+            }
+        }
+        g
+    }
+
+    /// The cell of `x`, widened by one cell towards `side` (-1 low, +1 high) when `x` is within
+    /// a tiny margin of the cell's border, clamped to the grid.
+    fn index(&self, x: DVec3, side: i32) -> [usize; 3] {
+        let f = (x - self.origin) / self.cell;
+        let margin = 1e-6 * f64::from(side);
+        let mut out = [0usize; 3];
+        for k in 0..3 {
+            let v = (f[k] + margin).floor();
+            out[k] = if v.is_nan() || v < 0.0 {
+                0
+            } else {
+                (v as usize).min(self.dims[k] - 1)
+            };
+        }
+        out
+    }
+
+    /// Whether segment [p, q] surely touches no piece box (false when unsure or too long).
+    fn surely_clear(&self, p: DVec3, q: DVec3) -> bool {
+        if self.bits.is_empty() {
+            return false;
+        }
+        let (lo, hi) = (p.min(q), p.max(q));
+        let inside_grid = |x: DVec3| {
+            let f = (x - self.origin) / self.cell;
+            (0..3).all(|k| f[k] >= 1.0 && f[k] < (self.dims[k] - 1) as f64)
+        };
+        if !inside_grid(lo) || !inside_grid(hi) {
+            // Outside the grid's margin there is no surface, but a segment from there may
+            // cross the grid: the tree decides.
+            return !self.overlaps_grid(lo, hi);
+        }
+        let (a, b) = (self.index(lo, -1), self.index(hi, 1));
+        if (0..3).any(|k| b[k] - a[k] >= GRID_SPAN) {
+            return false;
+        }
+        for k in a[2]..=b[2] {
+            for j in a[1]..=b[1] {
+                for i in a[0]..=b[0] {
+                    let c = (k * self.dims[1] + j) * self.dims[0] + i;
+                    if self.bits[c / 64] & (1 << (c % 64)) != 0 {
+                        return false;
+                    }
+                }
+            }
+        }
+        true
+    }
+
+    /// Whether the box [lo, hi] overlaps the grid's extent.
+    fn overlaps_grid(&self, lo: DVec3, hi: DVec3) -> bool {
+        let top = self.origin
+            + DVec3::new(
+                self.dims[0] as f64,
+                self.dims[1] as f64,
+                self.dims[2] as f64,
+            ) * self.cell;
+        (0..3).all(|k| hi[k] >= self.origin[k] && lo[k] <= top[k])
+    }
+}
+
+/// Every triangle cut by halving its longest edge until the pieces are at most `len` long (at
+/// most [`MAX_PIECES`] per triangle), as boxes.
+fn cut_into_pieces(surface: &InputSurface, len: f64) -> Vec<Piece> {
+    let mut pieces = Vec::with_capacity(surface.triangles.len());
+    let mut work = vec![];
+    for t in 0..surface.triangles.len() {
+        work.clear();
+        work.push(surface.corners(t));
+        let mut done = 0;
+        while let Some([a, b, c]) = work.pop() {
+            let edges = [(b - a).length(), (c - b).length(), (a - c).length()];
+            let longest = edges[0].max(edges[1]).max(edges[2]);
+            if longest <= len || done + work.len() + 2 > MAX_PIECES {
+                pieces.push(Piece {
+                    triangle: t as u32,
+                    lo: a.min(b).min(c),
+                    hi: a.max(b).max(c),
+                });
+                done += 1;
+                continue;
+            }
+            let halves = if edges[0] == longest {
+                let m = (a + b) / 2.0;
+                [[a, m, c], [m, b, c]]
+            } else if edges[1] == longest {
+                let m = (b + c) / 2.0;
+                [[a, b, m], [a, m, c]]
+            } else {
+                let m = (c + a) / 2.0;
+                [[a, b, m], [m, b, c]]
+            };
+            work.extend(halves);
+        }
+    }
+    pieces
+}
 
 /// Ray directions tried before giving up (each a generic direction; grazing rays are rare).
 const MAX_RAYS: usize = 64;
@@ -452,19 +667,36 @@ fn box_distance(node: &Node, p: DVec3) -> f64 {
     d.length()
 }
 
-/// Slab test of segment [p, q] against a (padded) box; conservative.
-fn segment_hits_box(node: &Node, p: DVec3, q: DVec3) -> bool {
-    let d = q - p;
+/// Segment [p, q] set up for slab tests against many boxes.
+struct Slab {
+    p: DVec3,
+    d: DVec3,
+    inv: DVec3,
+}
+
+impl Slab {
+    fn new(p: DVec3, q: DVec3) -> Slab {
+        let d = q - p;
+        Slab {
+            p,
+            d,
+            inv: DVec3::ONE / d,
+        }
+    }
+}
+
+/// Slab test of a segment against a (padded) box; conservative.
+fn segment_hits_box(node: &Node, s: &Slab) -> bool {
     let (mut t0, mut t1) = (0.0f64, 1.0f64);
     for k in 0..3 {
-        let (lo, hi, o, dk) = (node.lo[k], node.hi[k], p[k], d[k]);
+        let (lo, hi, o, dk) = (node.lo[k], node.hi[k], s.p[k], s.d[k]);
         if dk == 0.0 {
             if o < lo || o > hi {
                 return false;
             }
             continue;
         }
-        let (mut a, mut b) = ((lo - o) / dk, (hi - o) / dk);
+        let (mut a, mut b) = ((lo - o) * s.inv[k], (hi - o) * s.inv[k]);
         if a > b {
             std::mem::swap(&mut a, &mut b);
         }

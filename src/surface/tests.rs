@@ -211,6 +211,43 @@ fn segment_crossings_match_brute_force() {
     }
 }
 
+/// Short segments near the surface (Voronoi edges are: the occupancy grid answers most of
+/// them) and near joint's long thin triangles (cut into pieces in the tree): the same
+/// triangles as brute force, and the crossing parity agrees with the inside test.
+#[test]
+fn short_segment_crossings_and_parity_match_brute_force() {
+    for name in ["off/joint.off", "off/fandisk.off"] {
+        let s = model_surface(name);
+        let o = SurfaceOracle::new(&s);
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let d = s.bbox_diagonal();
+        let mut clean = 0;
+        for k in 0..3000 {
+            let v = s.vertices[rng.gen_range(0..s.vertices.len())];
+            let mut unit = || DVec3::new(rng.gen(), rng.gen(), rng.gen()) * 2.0 - DVec3::ONE;
+            let scale = [1e-3, 1e-2, 5e-2][k % 3] * d;
+            let p = v + unit() * scale;
+            let q = p + unit() * scale;
+            let (found, parity) = o.crossings_and_parity(p, q);
+            let mut fast: Vec<u32> = found.iter().map(|c| c.triangle).collect();
+            fast.sort_unstable();
+            let brute: Vec<u32> = (0..s.triangles.len() as u32)
+                .filter(|&t| {
+                    let [a, b, c] = s.corners(t as usize);
+                    crate::plc::exact::segment_meets_triangle(p, q, a, b, c)
+                })
+                .collect();
+            assert_eq!(fast, brute, "{name}: {p} {q}");
+            if let Some(odd) = parity {
+                clean += 1;
+                let sides = (o.side(p), o.side(q));
+                assert_eq!(odd, sides.0 != sides.1, "{name}: {p} {q} {sides:?}");
+            }
+        }
+        assert!(clean > 2900, "{name}: only {clean} clean parities");
+    }
+}
+
 #[test]
 fn inside_test_on_a_cylinder_and_a_model() {
     let s = prism(64, 2.0);
