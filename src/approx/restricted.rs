@@ -558,8 +558,12 @@ impl<'a> SurfaceMesher<'a> {
         quads.extend(created.iter().map(|&t| self.dt.tet(t)));
         let mut seen = FxHashSet::default();
         for tv in &quads {
+            let on_curve = tv.map(|v| self.on_curve(v));
             for i in 0..4 {
                 for j in i + 1..4 {
+                    if !(on_curve[i] && on_curve[j]) {
+                        continue; // subsegments join curve and corner vertices only
+                    }
                     let k = key2(tv[i], tv[j]);
                     if self.subsegs.contains_key(&k) && seen.insert(k) {
                         self.seg_queue.push(k);
@@ -600,6 +604,11 @@ impl<'a> SurfaceMesher<'a> {
             radius: best.0,
             triangle: best.1.triangle,
         })
+    }
+
+    /// Whether vertex `v` lies on a feature curve or at a corner (a subsegment may end there).
+    fn on_curve(&self, v: u32) -> bool {
+        v != INFINITE && matches!(self.loc[v as usize], Loc::Curve(_) | Loc::Corner(_))
     }
 
     fn on_patch(&self, v: u32, patch: u32) -> bool {
@@ -709,8 +718,12 @@ impl<'a> SurfaceMesher<'a> {
         let mut out = vec![];
         for &t in cavity {
             let tv = self.dt.tet(t);
+            let on_curve = tv.map(|v| self.on_curve(v));
             for i in 0..4 {
                 for j in i + 1..4 {
+                    if !(on_curve[i] && on_curve[j]) {
+                        continue;
+                    }
                     let k = key2(tv[i], tv[j]);
                     if out.contains(&k) || self.frozen.contains(&k) {
                         continue;

@@ -21,8 +21,9 @@ pub(super) struct Tracking {
     pub inside: Vec<bool>,
     /// Per tet id: its circumcentre (None: flat or infinite).
     pub centre: Vec<Option<DVec3>>,
-    /// The restricted facets (sorted vertices): surface centre and surface-ball radius.
-    pub restricted: FxHashMap<[u32; 3], (DVec3, f64)>,
+    /// The restricted facets (sorted vertices): surface centre, surface-ball radius and the
+    /// input triangle the centre lies on.
+    pub restricted: FxHashMap<[u32; 3], (DVec3, f64, u32)>,
 }
 
 /// Every tet's side and every restricted facet, from one pass over the triangulation.
@@ -42,7 +43,7 @@ impl SurfaceMesher<'_> {
             restricted: classified
                 .restricted
                 .iter()
-                .map(|r| (key3(r.vertices), (r.centre, r.radius)))
+                .map(|r| (key3(r.vertices), (r.centre, r.radius, r.triangle)))
                 .collect(),
         };
         for r in classified.restricted {
@@ -74,9 +75,15 @@ impl SurfaceMesher<'_> {
     /// once) and the bad restricted facets queued.
     pub(super) fn track_insertion(&mut self, new_vertex: u32, created: &[u32]) {
         let mut track = std::mem::take(&mut self.track);
+        // A facet found again with the same surface centre, ball and input triangle was judged
+        // already (its criteria depend on nothing else): it is not judged again.
+        let mut before = vec![];
         for tv in self.dt.last_removed() {
             for f in FACE {
-                track.restricted.remove(&key3(f.map(|k| tv[k])));
+                let key = key3(f.map(|k| tv[k]));
+                if let Some(old) = track.restricted.remove(&key) {
+                    before.push((key, old));
+                }
             }
         }
         let cap = self.dt.tet_capacity();
@@ -121,10 +128,12 @@ impl SurfaceMesher<'_> {
                 }
                 let face = FACE[i].map(|k| tv[k]);
                 if let Some(r) = Self::facet_from(&self.dt, face, crossings) {
-                    track
-                        .restricted
-                        .insert(key3(r.vertices), (r.centre, r.radius));
-                    found.push(r);
+                    let key = key3(r.vertices);
+                    let ball = (r.centre, r.radius, r.triangle);
+                    track.restricted.insert(key, ball);
+                    if !before.contains(&(key, ball)) {
+                        found.push(r);
+                    }
                 }
             }
         }

@@ -286,7 +286,7 @@ impl SurfaceMesher<'_> {
                     continue;
                 }
                 let key = key3(face);
-                if let Some(&(centre, radius)) = self.track.restricted.get(&key) {
+                if let Some(&(centre, radius, _)) = self.track.restricted.get(&key) {
                     if (p - centre).length_squared() < radius * radius
                         && best.is_none_or(|b| radius > b.1)
                     {
