@@ -134,7 +134,11 @@ impl Plane {
             c,
             normal: newell(&pts),
         };
-        if plane.normal == DVec3::ZERO || !pts.iter().all(|&q| plane.contains(q)) {
+        // The three points spanning the plane lie in it: testing them would only send the exact
+        // predicate down its slow path (a zero determinant is never clear to the fast filter).
+        let off_plane = |q: &&DVec3| **q != a && **q != b && **q != c;
+        if plane.normal == DVec3::ZERO || !pts.iter().filter(off_plane).all(|&q| plane.contains(q))
+        {
             return None;
         }
         Some(plane)
