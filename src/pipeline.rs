@@ -17,7 +17,7 @@ pub fn mesh(
     match params.surface_mode {
         SurfaceMode::Keep => {
             let (mesh, mut report) = refine::mesh(input, params, spacing, progress)?;
-            let mesh = crate::improve::finish(mesh, &mut report, Some(input), params)?;
+            let mesh = crate::improve::finish(mesh, &mut report, Some(input), params, None)?;
             Ok((mesh, report))
         }
         SurfaceMode::Approximate => crate::approx::mesh(input, params, spacing, progress),

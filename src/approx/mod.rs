@@ -67,6 +67,9 @@ pub struct Remeshed {
     pub small_corners: Vec<(glam::DVec3, f64)>,
     /// The vertices of `boundary` at small corners.
     pub small_corner_vertices: Vec<u32>,
+    /// Per vertex of `boundary`: the patch it lies inside (not on a curve or at a corner, not
+    /// in a small corner's ball), where the improvement may slide it.
+    pub vertex_patch: Vec<Option<u32>>,
     pub stop_reason: Option<String>,
     pub seconds: f64,
 }
@@ -80,7 +83,14 @@ pub fn mesh(
 ) -> Result<(TetMesh, Report), MeshError> {
     let start = std::time::Instant::now();
     let (remeshed, mesh, mut report) = mesh_restricted(input, params, spacing, progress)?;
-    let mesh = crate::improve::finish(mesh, &mut report, Some(&remeshed.boundary), params)?;
+    let oracle = SurfaceOracle::new(&remeshed.surface);
+    let slide = PatchSlide {
+        oracle: &oracle,
+        patch_of: &remeshed.features.patch_of,
+        vertex_patch: &remeshed.vertex_patch,
+        distance: DISTANCE_SAFETY * remeshed.distance,
+    };
+    let mesh = crate::improve::finish(mesh, &mut report, None, params, Some(&slide))?;
     let mut surface_report = measure::surface_report(&remeshed, &mesh);
     if report.stop_reason.is_none() {
         report.stop_reason = remeshed.stop_reason.clone();
@@ -92,6 +102,43 @@ pub fn mesh(
     report.surface = Some(surface_report);
     report.seconds_total = start.elapsed().as_secs_f64();
     Ok((mesh, report))
+}
+
+/// The boundary vertices inside a patch slide on that patch of the input surface during the
+/// improvement; a boundary triangle must keep its centroid and edge midpoints within the
+/// surface mesher's own distance criterion (half the bound) of the input.
+struct PatchSlide<'a> {
+    oracle: &'a SurfaceOracle<'a>,
+    patch_of: &'a [u32],
+    vertex_patch: &'a [Option<u32>],
+    distance: f64,
+}
+
+impl crate::improve::SurfaceSlide for PatchSlide<'_> {
+    fn slides(&self, v: u32) -> bool {
+        self.vertex_patch
+            .get(v as usize)
+            .copied()
+            .flatten()
+            .is_some()
+    }
+
+    fn project(&self, v: u32, x: glam::DVec3) -> Option<glam::DVec3> {
+        let patch = self.vertex_patch.get(v as usize).copied().flatten()?;
+        let c = self.oracle.closest(x)?;
+        (self.patch_of[c.triangle as usize] == patch).then_some(c.point)
+    }
+
+    fn keeps_close(&self, [a, b, c]: [glam::DVec3; 3]) -> bool {
+        [
+            (a + b + c) / 3.0,
+            (a + b) / 2.0,
+            (b + c) / 2.0,
+            (c + a) / 2.0,
+        ]
+        .into_iter()
+        .all(|p| self.oracle.distance_beyond(p, self.distance).is_none())
+    }
 }
 
 /// Steps 3 and 4 in one triangulation: the restricted Delaunay surface, then its cells
@@ -237,16 +284,26 @@ pub fn remesh(
         .collect();
     // The boundary vertices in a small corner's protecting ball, where the surface mesher left
     // facet angles alone and the cells are not refined (the report counts them).
+    let in_small_corner = |p: glam::DVec3| {
+        curves
+            .small_corners()
+            .any(|c| (p - c.point).length_squared() <= c.protect_radius * c.protect_radius)
+    };
     let small_corner_vertices = (0..b.loc.len() as u32)
-        .filter(|&v| {
-            let p = b.points[v as usize];
-            curves
-                .small_corners()
-                .any(|c| (p - c.point).length_squared() <= c.protect_radius * c.protect_radius)
+        .filter(|&v| in_small_corner(b.points[v as usize]))
+        .collect();
+    let vertex_patch = b
+        .loc
+        .iter()
+        .zip(&b.points)
+        .map(|(loc, &p)| match loc {
+            restricted::Loc::Patch(k) if !in_small_corner(p) => Some(*k),
+            _ => None,
         })
         .collect();
     let remeshed = Remeshed {
         small_corner_vertices,
+        vertex_patch,
         input_volume: plc.volume(),
         n_corners: curves.corners.len(),
         small_corners,

@@ -80,6 +80,19 @@ fn check_mesh(name: &str, size: Option<f64>) -> (TetMesh, Report) {
         open, boundary,
         "{name}: boundary triangles are not the open tet faces"
     );
+    // Every boundary vertex lies on the input surface (surface centres and curve points are
+    // on it, and the improvement slides vertices back onto it).
+    let plc = crate::plc::validate(&input).unwrap();
+    let surface = crate::surface::InputSurface::from_plc(&plc);
+    let oracle = crate::surface::oracle::SurfaceOracle::new(&surface);
+    let tolerance = 1e-9 * surface.bbox_diagonal();
+    for &v in mesh.boundary.iter().flatten() {
+        let p = mesh.vertices[v as usize];
+        assert!(
+            oracle.distance_beyond(p, tolerance).is_none(),
+            "{name}: boundary vertex {v} at {p} is off the input surface"
+        );
+    }
     let s = report
         .surface
         .clone()

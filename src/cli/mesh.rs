@@ -175,7 +175,8 @@ pub fn run_mesh(
         let (mesh, mut report) =
             refine::existing::remove_slivers(&existing, &params).map_err(|e| e.to_string())?;
         // The existing mesh's boundary stays as it is (no facet description to move within).
-        let mesh = improve::finish(mesh, &mut report, None, &params).map_err(|e| e.to_string())?;
+        let mesh =
+            improve::finish(mesh, &mut report, None, &params, None).map_err(|e| e.to_string())?;
         (mesh, report)
     } else {
         let merge = !opts.no_merge && io::is_surface_file(input);

@@ -309,3 +309,23 @@ pub(crate) fn classify(w: &mut Work, input: Option<&PlcInput>) -> (Vec<Constrain
     }
     (cons, normals)
 }
+
+/// Boundary vertices `slide` lets move get their tangent plane (the area-weighted normal of
+/// their boundary triangles) as constraint; the rest stay as `classify` left them.
+pub(crate) fn let_slide(w: &Work, cons: &mut [Constraint], slide: &dyn super::SurfaceSlide) {
+    for (v, c) in cons.iter_mut().enumerate() {
+        if w.bstar[v].is_empty() || w.star[v].is_empty() || !slide.slides(v as u32) {
+            continue;
+        }
+        let n: DVec3 = w.bstar[v]
+            .iter()
+            .map(|&bt| {
+                let [a, b, c] = w.btri[bt as usize].map(|u| w.pos[u as usize]);
+                (b - a).cross(c - a)
+            })
+            .sum();
+        if let Some(n) = n.try_normalize() {
+            *c = Constraint::Plane(n);
+        }
+    }
+}

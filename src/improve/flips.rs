@@ -50,7 +50,7 @@ fn old_min(w: &Work, tets: &[u32]) -> (f64, Option<i32>) {
 /// The smallest gain that counts (keeps rounding noise from cycling).
 pub(crate) const MIN_GAIN: f64 = 1e-9;
 
-impl Improver {
+impl Improver<'_> {
     /// Objective of a would-be tet, or -inf when it is not positively oriented (exact test,
     /// only made for tets that could help).
     fn candidate(&self, t: [u32; 4], floor: f64) -> f64 {

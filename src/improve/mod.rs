@@ -85,11 +85,25 @@ impl Stats {
     }
 }
 
-pub(crate) struct Improver {
+pub(crate) struct Improver<'s> {
     w: Work,
     cons: Vec<Constraint>,
     normals: Vec<DVec3>,
+    /// Approximate mode: the boundary vertices that slide on the input surface, and how.
+    slide: Option<&'s dyn SurfaceSlide>,
     stats: Stats,
+}
+
+/// How the boundary vertices of an approximated surface may move (approximate mode): within
+/// their tangent plane, then put back on the input surface, as long as the boundary triangles
+/// around them stay close to it.
+pub trait SurfaceSlide {
+    /// Whether boundary vertex `v` may move (not on a feature curve or at a corner).
+    fn slides(&self, v: u32) -> bool;
+    /// `x` put on the part of the input surface where `v` may lie, or None.
+    fn project(&self, v: u32, x: DVec3) -> Option<DVec3>;
+    /// Whether a boundary triangle with these corners stays within the distance bound.
+    fn keeps_close(&self, triangle: [DVec3; 3]) -> bool;
 }
 
 /// Objective above which a tet's float orientation is taken as its exact one (it is a ratio of
@@ -113,14 +127,29 @@ fn key(q: f64) -> u64 {
 /// vertices move within their facet or segment and boundary triangles of one facet may flip;
 /// without it (an existing mesh) the boundary stays as it is.
 pub fn improve(mesh: &TetMesh, input: Option<&PlcInput>, opts: &Options) -> (TetMesh, Stats) {
+    improve_with(mesh, input, opts, None)
+}
+
+/// [`improve`], with the boundary vertices `slide` names moving on the input surface (an
+/// approximated surface; `input` is then None).
+pub fn improve_with(
+    mesh: &TetMesh,
+    input: Option<&PlcInput>,
+    opts: &Options,
+    slide: Option<&dyn SurfaceSlide>,
+) -> (TetMesh, Stats) {
     let start = std::time::Instant::now();
     let rho_weight = opts.target_deg.to_radians().sin() * opts.max_rho;
     let mut w = Work::new(mesh, rho_weight);
-    let (cons, normals) = constraints::classify(&mut w, input);
+    let (mut cons, normals) = constraints::classify(&mut w, input);
+    if let Some(s) = slide {
+        constraints::let_slide(&w, &mut cons, s);
+    }
     let mut im = Improver {
         w,
         cons,
         normals,
+        slide,
         stats: Stats::default(),
     };
     im.stats.degenerate_before = (0..im.w.tets.len())
@@ -133,7 +162,7 @@ pub fn improve(mesh: &TetMesh, input: Option<&PlcInput>, opts: &Options) -> (Tet
     (im.w.to_mesh(), im.stats)
 }
 
-impl Improver {
+impl Improver<'_> {
     fn bad(&self, t: u32, target: f64, improve: bool) -> bool {
         let q = self.w.q[t as usize];
         if improve && q < target {
@@ -308,6 +337,7 @@ pub fn finish(
     report: &mut Report,
     input: Option<&PlcInput>,
     params: &crate::refine::Params,
+    slide: Option<&dyn SurfaceSlide>,
 ) -> Result<TetMesh, MeshError> {
     let opts = Options {
         improve: params.improve,
@@ -321,7 +351,7 @@ pub fn finish(
         ..Options::default()
     };
     let before = (report.min_dihedral_deg, report.max_dihedral_deg);
-    let (out, stats) = improve(&mesh, input, &opts);
+    let (out, stats) = improve_with(&mesh, input, &opts, slide);
     check_no_degenerate(&out)?;
     if stats.changed() {
         update_report(report, &out);

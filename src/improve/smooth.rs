@@ -58,7 +58,7 @@ fn min_norm(g: &[DVec3]) -> DVec3 {
     }
 }
 
-impl Improver {
+impl Improver<'_> {
     /// Worst objective of v's star with v at x.
     fn star_min(&self, star: &[[u32; 4]], v: u32, x: DVec3) -> f64 {
         star.iter()
@@ -164,6 +164,14 @@ impl Improver {
                 break;
             }
         }
+        if let Some(s) = self.sliding(v) {
+            // Back onto the input surface, where the move is judged.
+            let Some(y) = s.project(v, x) else {
+                return false;
+            };
+            x = y;
+            qx = self.star_min(&star, v, x);
+        }
         if qx <= q0 + SMOOTH_GAIN || qx.is_nan() || !self.valid_move(&star, v, x) {
             return false;
         }
@@ -175,9 +183,30 @@ impl Improver {
         true
     }
 
+    /// The slide of boundary vertex `v`, if it slides on the input surface.
+    fn sliding(&self, v: u32) -> Option<&dyn super::SurfaceSlide> {
+        self.slide
+            .filter(|s| !self.w.bstar[v as usize].is_empty() && s.slides(v))
+    }
+
     /// Exact orientation of every star tet with v at x, and the boundary triangles' sides.
     fn valid_move(&mut self, star: &[[u32; 4]], v: u32, x: DVec3) -> bool {
         let old = self.w.pos[v as usize];
+        if let Some(s) = self.sliding(v) {
+            // On a curved surface: no boundary triangle turns over, and each stays close.
+            for &bt in &self.w.bstar[v as usize] {
+                let tri = self.w.btri[bt as usize];
+                let at = |y: DVec3| tri.map(|u| if u == v { y } else { self.w.pos[u as usize] });
+                let normal = |[a, b, c]: [DVec3; 3]| (b - a).cross(c - a);
+                if normal(at(old)).dot(normal(at(x))) <= 0.0 || !s.keeps_close(at(x)) {
+                    return false;
+                }
+            }
+            self.w.pos[v as usize] = x;
+            let ok = star.iter().all(|&t| self.w.positive(t));
+            self.w.pos[v as usize] = old;
+            return ok;
+        }
         let mut side_ok = true;
         for &bt in &self.w.bstar[v as usize] {
             let patch = self.w.bpatch[bt as usize];

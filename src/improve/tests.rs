@@ -258,7 +258,7 @@ fn flat_tet_on_a_facet_is_flipped_away() {
             improve: improve_on,
             ..Default::default()
         };
-        let out = finish(mesh.clone(), &mut report, Some(&input), &params).unwrap();
+        let out = finish(mesh.clone(), &mut report, Some(&input), &params, None).unwrap();
         assert_eq!(out.tets.len(), 2, "{:?}", report.improvement);
         assert_eq!(report.improvement.boundary_flips, 1);
         assert!(!report.delaunay);
@@ -283,7 +283,7 @@ fn flat_tet_on_a_facet_is_flipped_away() {
     // Without the input description the boundary may not flip; here the interior 3-2 flip
     // of edge 1-3 removes the flat tet instead, keeping the base's triangles.
     let mut report = Report::default();
-    let out = finish(mesh.clone(), &mut report, None, &Default::default()).unwrap();
+    let out = finish(mesh.clone(), &mut report, None, &Default::default(), None).unwrap();
     assert_eq!(out.boundary, mesh.boundary);
     assert_eq!(report.improvement.edge_removals, 1);
     assert_eq!(out.tets.len(), 2);
@@ -319,6 +319,7 @@ fn two_three_flip() {
         w,
         cons: vec![Constraint::Fixed; 5],
         normals: vec![],
+        slide: None,
         stats: Stats::default(),
     };
     let plan = im.plan_face([0, 1, 2]).expect("2-3 flip improves");
