@@ -44,9 +44,8 @@ fn one_sided(from: &InputSurface, to: &InputSurface) -> f64 {
 const FEATURE_EDGE_SAMPLES: usize = 8;
 
 pub fn surface_report(r: &Remeshed, mesh: &TetMesh) -> SurfaceReport {
-    // The output boundary is the remeshed triangles subdivided in their own planes (keep mode
-    // on them): the same surface, with far fewer triangles to sample.
-    let out = remeshed_surface(r);
+    // The output boundary: the remeshed triangles where the improvement left their vertices.
+    let out = output_surface(mesh);
     let out_volume: f64 = mesh
         .tets
         .iter()
@@ -59,7 +58,7 @@ pub fn surface_report(r: &Remeshed, mesh: &TetMesh) -> SurfaceReport {
         surface_distance: r.distance,
         hausdorff_input_to_output: one_sided(&r.surface, &out),
         hausdorff_output_to_input: one_sided(&out, &r.surface),
-        feature_distance: feature_distance(r),
+        feature_distance: feature_distance(r, &mesh.vertices),
         relative_volume_difference: if r.input_volume > 0.0 {
             (out_volume - r.input_volume) / r.input_volume
         } else {
@@ -78,23 +77,17 @@ pub fn surface_report(r: &Remeshed, mesh: &TetMesh) -> SurfaceReport {
     }
 }
 
-fn remeshed_surface(r: &Remeshed) -> InputSurface {
-    let triangles = r
-        .boundary
-        .facets
-        .iter()
-        .map(|f| [f.polygons[0][0], f.polygons[0][1], f.polygons[0][2]])
-        .collect();
-    InputSurface::from_triangles(r.boundary.vertices.clone(), triangles)
+fn output_surface(mesh: &TetMesh) -> InputSurface {
+    InputSurface::from_triangles(mesh.vertices.clone(), mesh.boundary.clone())
 }
 
 /// Largest distance from a sample of an input feature edge to the nearest output feature edge
 /// (brute force over the output's feature edges, which number a few thousand).
-fn feature_distance(r: &Remeshed) -> f64 {
+fn feature_distance(r: &Remeshed, positions: &[DVec3]) -> f64 {
     let segs: Vec<(DVec3, DVec3)> = r
         .feature_edges
         .iter()
-        .map(|e| e.map(|v| r.boundary.vertices[v as usize]))
+        .map(|e| e.map(|v| positions[v as usize]))
         .map(|[a, b]| (a, b))
         .collect();
     let mut worst: f64 = 0.0;
