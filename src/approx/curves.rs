@@ -44,6 +44,22 @@ impl Curve {
         self.points[k - 1].lerp(self.points[k], t)
     }
 
+    /// The point of the curve nearest to `p`, and the unit direction of the curve there.
+    pub fn closest(&self, p: DVec3) -> Option<(DVec3, DVec3)> {
+        self.points
+            .windows(2)
+            .filter_map(|w| {
+                let (a, b) = (w[0], w[1]);
+                let d = b - a;
+                let len2 = d.length_squared();
+                (len2 > 0.0).then(|| {
+                    let t = ((p - a).dot(d) / len2).clamp(0.0, 1.0);
+                    (a + d * t, d / len2.sqrt())
+                })
+            })
+            .min_by(|x, y| x.0.distance_squared(p).total_cmp(&y.0.distance_squared(p)))
+    }
+
     /// Largest distance of the curve between arc lengths `s0 < s1` from the chord joining
     /// its points there.
     pub fn chord_deviation(&self, s0: f64, s1: f64) -> f64 {

@@ -67,9 +67,11 @@ pub struct Remeshed {
     pub small_corners: Vec<(glam::DVec3, f64)>,
     /// The vertices of `boundary` at small corners.
     pub small_corner_vertices: Vec<u32>,
-    /// Per vertex of `boundary`: the patch it lies inside (not on a curve or at a corner, not
-    /// in a small corner's ball), where the improvement may slide it.
-    pub vertex_patch: Vec<Option<u32>>,
+    /// Per vertex of `boundary`: where the improvement may slide it (none at corners and in
+    /// small corners' balls).
+    pub vertex_slide: Vec<Slide>,
+    /// The feature curves (`Slide::Curve` indexes them).
+    pub curves: FeatureCurves,
     pub stop_reason: Option<String>,
     pub seconds: f64,
 }
@@ -84,10 +86,11 @@ pub fn mesh(
     let start = std::time::Instant::now();
     let (remeshed, mesh, mut report) = mesh_restricted(input, params, spacing, progress)?;
     let oracle = SurfaceOracle::new(&remeshed.surface);
-    let slide = PatchSlide {
+    let slide = SurfaceSlide {
         oracle: &oracle,
         patch_of: &remeshed.features.patch_of,
-        vertex_patch: &remeshed.vertex_patch,
+        curves: &remeshed.curves,
+        vertex_slide: &remeshed.vertex_slide,
         distance: DISTANCE_SAFETY * remeshed.distance,
     };
     let mesh = crate::improve::finish(mesh, &mut report, None, params, Some(&slide))?;
@@ -104,29 +107,59 @@ pub fn mesh(
     Ok((mesh, report))
 }
 
-/// The boundary vertices inside a patch slide on that patch of the input surface during the
-/// improvement; a boundary triangle must keep its centroid and edge midpoints within the
-/// surface mesher's own distance criterion (half the bound) of the input.
-struct PatchSlide<'a> {
+/// Where a boundary vertex may move during the improvement.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Slide {
+    Fixed,
+    /// On this patch of the input surface.
+    Patch(u32),
+    /// Along this feature curve.
+    Curve(u32),
+}
+
+/// The improvement's view of the input: boundary vertices inside a patch slide on that patch,
+/// those on a feature curve along the curve; a boundary triangle must keep its centroid and
+/// edge midpoints within the surface mesher's own distance criterion (half the bound).
+struct SurfaceSlide<'a> {
     oracle: &'a SurfaceOracle<'a>,
     patch_of: &'a [u32],
-    vertex_patch: &'a [Option<u32>],
+    curves: &'a FeatureCurves,
+    vertex_slide: &'a [Slide],
     distance: f64,
 }
 
-impl crate::improve::SurfaceSlide for PatchSlide<'_> {
-    fn slides(&self, v: u32) -> bool {
-        self.vertex_patch
+impl SurfaceSlide<'_> {
+    fn slide(&self, v: u32) -> Slide {
+        self.vertex_slide
             .get(v as usize)
             .copied()
-            .flatten()
-            .is_some()
+            .unwrap_or(Slide::Fixed)
+    }
+}
+
+impl crate::improve::SurfaceSlide for SurfaceSlide<'_> {
+    fn slides(&self, v: u32) -> bool {
+        self.slide(v) != Slide::Fixed
+    }
+
+    fn along(&self, v: u32, at: glam::DVec3) -> Option<glam::DVec3> {
+        match self.slide(v) {
+            Slide::Curve(c) => self.curves.curves[c as usize]
+                .closest(at)
+                .map(|(_, dir)| dir),
+            _ => None,
+        }
     }
 
     fn project(&self, v: u32, x: glam::DVec3) -> Option<glam::DVec3> {
-        let patch = self.vertex_patch.get(v as usize).copied().flatten()?;
-        let c = self.oracle.closest(x)?;
-        (self.patch_of[c.triangle as usize] == patch).then_some(c.point)
+        match self.slide(v) {
+            Slide::Fixed => None,
+            Slide::Patch(patch) => {
+                let c = self.oracle.closest(x)?;
+                (self.patch_of[c.triangle as usize] == patch).then_some(c.point)
+            }
+            Slide::Curve(c) => self.curves.curves[c as usize].closest(x).map(|(p, _)| p),
+        }
     }
 
     fn keeps_close(&self, [a, b, c]: [glam::DVec3; 3]) -> bool {
@@ -292,20 +325,23 @@ pub fn remesh(
     let small_corner_vertices = (0..b.loc.len() as u32)
         .filter(|&v| in_small_corner(b.points[v as usize]))
         .collect();
-    let vertex_patch = b
+    let vertex_slide = b
         .loc
         .iter()
         .zip(&b.points)
         .map(|(loc, &p)| match loc {
-            restricted::Loc::Patch(k) if !in_small_corner(p) => Some(*k),
-            _ => None,
+            _ if in_small_corner(p) => Slide::Fixed,
+            restricted::Loc::Patch(k) => Slide::Patch(*k),
+            restricted::Loc::Curve(c) => Slide::Curve(*c),
+            _ => Slide::Fixed,
         })
         .collect();
     let remeshed = Remeshed {
         small_corner_vertices,
-        vertex_patch,
+        vertex_slide,
         input_volume: plc.volume(),
         n_corners: curves.corners.len(),
+        curves,
         small_corners,
         surface,
         features,

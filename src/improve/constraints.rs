@@ -310,11 +310,16 @@ pub(crate) fn classify(w: &mut Work, input: Option<&PlcInput>) -> (Vec<Constrain
     (cons, normals)
 }
 
-/// Boundary vertices `slide` lets move get their tangent plane (the area-weighted normal of
-/// their boundary triangles) as constraint; the rest stay as `classify` left them.
+/// Boundary vertices `slide` lets move get their curve's direction or their tangent plane (the
+/// area-weighted normal of their boundary triangles) as constraint; the rest stay as
+/// `classify` left them.
 pub(crate) fn let_slide(w: &Work, cons: &mut [Constraint], slide: &dyn super::SurfaceSlide) {
     for (v, c) in cons.iter_mut().enumerate() {
         if w.bstar[v].is_empty() || w.star[v].is_empty() || !slide.slides(v as u32) {
+            continue;
+        }
+        if let Some(u) = slide.along(v as u32, w.pos[v]) {
+            *c = Constraint::Line(u);
             continue;
         }
         let n: DVec3 = w.bstar[v]

@@ -98,8 +98,11 @@ pub(crate) struct Improver<'s> {
 /// their tangent plane, then put back on the input surface, as long as the boundary triangles
 /// around them stay close to it.
 pub trait SurfaceSlide {
-    /// Whether boundary vertex `v` may move (not on a feature curve or at a corner).
+    /// Whether boundary vertex `v` may move (not at a corner).
     fn slides(&self, v: u32) -> bool;
+    /// For a vertex on a feature curve (at `at`): the curve's direction there (it moves along
+    /// it); None for a vertex inside a patch (it moves in its tangent plane).
+    fn along(&self, v: u32, at: DVec3) -> Option<DVec3>;
     /// `x` put on the part of the input surface where `v` may lie, or None.
     fn project(&self, v: u32, x: DVec3) -> Option<DVec3>;
     /// Whether a boundary triangle with these corners stays within the distance bound.
