@@ -15,7 +15,7 @@ use super::{key3, Bad, Loc, Restricted, SurfaceMesher};
 use crate::delaunay::tables::FACE;
 use crate::delaunay::{Inserted, Probe, INFINITE};
 use crate::geom::circumsphere;
-use crate::geom::screen::{shortest_edge_sq, sliver_measures};
+use crate::geom::screen::{shortest_edge_sq, sliver_measures, SliverScreen};
 use crate::refine::{AutoSpacing, Spacing};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
@@ -53,6 +53,8 @@ const MAX_CELL_DEFERRALS: u8 = 4;
 pub(super) struct VolumeState {
     crit: VolumeCriteria,
     cos_min_dihedral: f64,
+    /// Clears most new tets from squared measures alone (`geom::screen`).
+    screen: SliverScreen,
     queues: [VecDeque<(u32, [u32; 4])>; 3],
     deferrals: FxHashMap<[u32; 4], u8>,
     pub(super) spacing: Option<AutoSpacing>,
@@ -81,6 +83,7 @@ impl SurfaceMesher<'_> {
         self.vol = Some(Box::new(VolumeState {
             crit,
             cos_min_dihedral: crit.min_dihedral_deg.to_radians().cos(),
+            screen: SliverScreen::new(crit.sigma0, crit.min_dihedral_deg),
             queues: Default::default(),
             deferrals: FxHashMap::default(),
             spacing,
@@ -372,6 +375,9 @@ impl SurfaceMesher<'_> {
                 continue;
             }
             let [x, y, z] = v.map(|k| self.dt.point(k));
+            if vol.screen.clearly_not_sliver(x, y, z, p) {
+                continue;
+            }
             let l2 = shortest_edge_sq(x, y, z, p);
             let (sigma, max_cos) = sliver_measures(x, y, z, p, l2);
             if (sigma < vol.crit.sigma0 || max_cos > vol.cos_min_dihedral)
