@@ -74,6 +74,8 @@ pub struct SurfaceOracle<'a> {
     order: Vec<u32>,
     /// Per leaf position in `order`: the piece's triangle.
     leaf_tri: Vec<u32>,
+    /// Every triangle's corner points, side by side (the queries' innermost loads).
+    corners: Vec<[DVec3; 3]>,
     grid: Occupancy,
     /// Triangles with three collinear corners take no part in exact queries.
     flat: Vec<bool>,
@@ -91,6 +93,7 @@ impl<'a> SurfaceOracle<'a> {
             nodes: Vec::with_capacity(2 * pieces.len() / LEAF_SIZE + 1),
             order: (0..pieces.len() as u32).collect(),
             leaf_tri: vec![],
+            corners: (0..n).map(|t| surface.corners(t)).collect(),
             grid: Occupancy::new(&pieces, PIECE_FRACTION * diagonal),
             pieces,
             flat: (0..n).map(|t| is_flat(surface.corners(t))).collect(),
@@ -180,7 +183,7 @@ impl<'a> SurfaceOracle<'a> {
             }
             if node.count > 0 {
                 for &t in self.leaf_triangles(node) {
-                    let [a, b, c] = self.surface.corners(t as usize);
+                    let [a, b, c] = self.corners[t as usize];
                     let q = closest_on_triangle(p, a, b, c);
                     let d = (q - p).length();
                     if best.is_none_or(|b| d < b.distance) {
@@ -220,7 +223,7 @@ impl<'a> SurfaceOracle<'a> {
     /// at the first test.
     pub fn distance_beyond_hinted(&self, p: DVec3, r: f64, hint: &mut Option<u32>) -> Option<f64> {
         let within = |t: u32| {
-            let [a, b, c] = self.surface.corners(t as usize);
+            let [a, b, c] = self.corners[t as usize];
             (closest_on_triangle(p, a, b, c) - p).length() <= r
         };
         if hint.is_some_and(|t| (t as usize) < self.surface.triangles.len() && within(t)) {
@@ -261,7 +264,7 @@ impl<'a> SurfaceOracle<'a> {
             if self.flat[t as usize] {
                 return;
             }
-            let [a, b, c] = self.surface.corners(t as usize);
+            let [a, b, c] = self.corners[t as usize];
             if segment_meets_triangle(p, q, a, b, c) {
                 let t_param = crossing_parameter(p, q, a, b, c);
                 out.push(Crossing {
@@ -285,7 +288,7 @@ impl<'a> SurfaceOracle<'a> {
             if self.flat[t as usize] {
                 return;
             }
-            let [a, b, c] = self.surface.corners(t as usize);
+            let [a, b, c] = self.corners[t as usize];
             if segment_meets_triangle(p, q, a, b, c) {
                 let t_param = crossing_parameter(p, q, a, b, c);
                 out.push(Crossing {
@@ -330,7 +333,7 @@ impl<'a> SurfaceOracle<'a> {
             if degenerate || on_surface || self.flat[t as usize] {
                 return;
             }
-            let [a, b, c] = self.surface.corners(t as usize);
+            let [a, b, c] = self.corners[t as usize];
             match proper_crossing(p, q, a, b, c) {
                 Crossed::No => {}
                 Crossed::Yes => odd = !odd,
