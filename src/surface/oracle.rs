@@ -67,7 +67,8 @@ pub enum Side {
 
 /// An AABB tree over the triangles of an [`InputSurface`].
 pub struct SurfaceOracle<'a> {
-    surface: &'a InputSurface,
+    /// The oracle copies what it needs (corners, adjacency) but answers for this surface.
+    surface: std::marker::PhantomData<&'a InputSurface>,
     nodes: Vec<Node>,
     pieces: Vec<Piece>,
     /// Piece ids in leaf order.
@@ -76,6 +77,9 @@ pub struct SurfaceOracle<'a> {
     leaf_tri: Vec<u32>,
     /// Every triangle's corner points, side by side (the queries' innermost loads).
     corners: Vec<[DVec3; 3]>,
+    /// Per triangle: the triangles across its three edges (`NO_NEIGHBOUR` on a border or a
+    /// non-manifold edge).
+    neighbours: Vec<[u32; 3]>,
     grid: Occupancy,
     /// Triangles with three collinear corners take no part in exact queries.
     flat: Vec<bool>,
@@ -89,11 +93,12 @@ impl<'a> SurfaceOracle<'a> {
         let diagonal = surface.bbox_diagonal();
         let pieces = cut_into_pieces(surface, PIECE_FRACTION * diagonal);
         let mut o = SurfaceOracle {
-            surface,
+            surface: std::marker::PhantomData,
             nodes: Vec::with_capacity(2 * pieces.len() / LEAF_SIZE + 1),
             order: (0..pieces.len() as u32).collect(),
             leaf_tri: vec![],
             corners: (0..n).map(|t| surface.corners(t)).collect(),
+            neighbours: edge_neighbours(&surface.triangles),
             grid: Occupancy::new(&pieces, PIECE_FRACTION * diagonal),
             pieces,
             flat: (0..n).map(|t| is_flat(surface.corners(t))).collect(),
@@ -226,8 +231,19 @@ impl<'a> SurfaceOracle<'a> {
             let [a, b, c] = self.corners[t as usize];
             (closest_on_triangle(p, a, b, c) - p).length() <= r
         };
-        if hint.is_some_and(|t| (t as usize) < self.surface.triangles.len() && within(t)) {
-            return None;
+        if let Some(h) = hint.filter(|&t| (t as usize) < self.corners.len()) {
+            if within(h) {
+                return None;
+            }
+            // The next point of a run of samples mostly lies over a neighbour of the last
+            // triangle found.
+            if let Some(&n) = self.neighbours[h as usize]
+                .iter()
+                .find(|&&n| n != NO_NEIGHBOUR && within(n))
+            {
+                *hint = Some(n);
+                return None;
+            }
         }
         let mut stack = [0usize; 128];
         let mut top = usize::from(!self.nodes.is_empty());
@@ -385,6 +401,30 @@ impl<'a> SurfaceOracle<'a> {
 }
 
 struct OnSurface;
+
+/// See `SurfaceOracle::neighbours`.
+const NO_NEIGHBOUR: u32 = u32::MAX;
+
+/// The triangles across each triangle's edges (`NO_NEIGHBOUR` unless exactly two share it).
+fn edge_neighbours(triangles: &[[u32; 3]]) -> Vec<[u32; 3]> {
+    let mut edges: Vec<(u64, u32, u8)> = Vec::with_capacity(3 * triangles.len());
+    for (t, tri) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            let key = (u64::from(a.min(b)) << 32) | u64::from(a.max(b));
+            edges.push((key, t as u32, k as u8));
+        }
+    }
+    edges.sort_unstable();
+    let mut out = vec![[NO_NEIGHBOUR; 3]; triangles.len()];
+    for run in edges.chunk_by(|x, y| x.0 == y.0) {
+        if let [(_, t, i), (_, u, j)] = *run {
+            out[t as usize][i as usize] = u;
+            out[u as usize][j as usize] = t;
+        }
+    }
+    out
+}
 
 /// The triangles one segment query has handed out (pieces of a triangle share its tests).
 #[derive(Default)]

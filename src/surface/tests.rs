@@ -181,6 +181,30 @@ fn closest_point_matches_brute_force() {
     }
 }
 
+/// A run of nearby queries with a hint (the last triangle found, then its neighbours) answers
+/// exactly as the plain query.
+#[test]
+fn hinted_distance_queries_match_plain_ones() {
+    let s = model_surface("off/fandisk.off");
+    let o = SurfaceOracle::new(&s);
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let d = s.bbox_diagonal();
+    let mut hint = None;
+    let mut p = s.vertices[0];
+    for k in 0..3000 {
+        if k % 100 == 0 {
+            p = s.vertices[rng.gen_range(0..s.vertices.len())];
+        }
+        p += DVec3::new(rng.gen(), rng.gen(), rng.gen()) * 4e-3 * d - DVec3::splat(2e-3 * d);
+        let r = [1e-4, 1e-3, 1e-2][k % 3] * d;
+        assert_eq!(
+            o.distance_beyond_hinted(p, r, &mut hint),
+            o.distance_beyond(p, r),
+            "{p} {r}"
+        );
+    }
+}
+
 #[test]
 fn segment_crossings_match_brute_force() {
     let s = model_surface("off/joint.off");
