@@ -11,6 +11,7 @@ mod recover;
 pub mod report;
 mod spacing;
 
+pub(crate) use quality::random_in_unit_ball;
 pub use spacing::AutoSpacing;
 
 use crate::mesh::TetMesh;

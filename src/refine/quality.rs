@@ -479,16 +479,7 @@ impl<'a> Refiner<'a> {
     }
 
     fn random_in_ball(&mut self) -> DVec3 {
-        loop {
-            let v = DVec3::new(
-                self.rng.gen_range(-1.0..1.0),
-                self.rng.gen_range(-1.0..1.0),
-                self.rng.gen_range(-1.0..1.0),
-            );
-            if v.length_squared() <= 1.0 {
-                return v;
-            }
-        }
+        random_in_unit_ball(&mut self.rng)
     }
 
     /// Probes candidate `p` for a bad element of circumradius `r` and makes it `best` if it
@@ -820,6 +811,20 @@ const FAR_CENTRE_PER_EDGE: f64 = 100.0;
 /// Longest edge over circumradius of a regular tet (sqrt(8/3)): the size measure next to small
 /// angles compares the longest edge with this many times f.
 const EDGE_PER_RADIUS: f64 = 1.632_993_161_855_452;
+
+/// A uniformly random point of the closed unit ball (rejection from the cube).
+pub(crate) fn random_in_unit_ball(rng: &mut impl Rng) -> DVec3 {
+    loop {
+        let v = DVec3::new(
+            rng.gen_range(-1.0..1.0),
+            rng.gen_range(-1.0..1.0),
+            rng.gen_range(-1.0..1.0),
+        );
+        if v.length_squared() <= 1.0 {
+            return v;
+        }
+    }
+}
 
 /// A tet's vertex ids in increasing order (a key independent of orientation).
 pub fn sorted4(mut t: [u32; 4]) -> [u32; 4] {

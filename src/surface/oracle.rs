@@ -275,31 +275,29 @@ impl<'a> SurfaceOracle<'a> {
 
     /// Every triangle the closed segment [p, q] meets, ordered by parameter then triangle id.
     pub fn crossings(&self, p: DVec3, q: DVec3) -> Vec<Crossing> {
-        let mut out = Vec::new();
-        self.visit_segment(p, q, |t| {
-            if self.flat[t as usize] {
-                return;
-            }
-            let [a, b, c] = self.corners[t as usize];
-            if segment_meets_triangle(p, q, a, b, c) {
-                let t_param = crossing_parameter(p, q, a, b, c);
-                out.push(Crossing {
-                    triangle: t,
-                    t: t_param,
-                    point: p + (q - p) * t_param,
-                });
-            }
-        });
-        out.sort_by(|x, y| x.t.total_cmp(&y.t).then(x.triangle.cmp(&y.triangle)));
-        out
+        self.collect_crossings(p, q, |_| {})
     }
 
     /// [`Self::crossings`], and whether p and q lie on different sides of the closed surface
     /// when that is clean to tell: every crossing proper (not through an edge, a vertex or
     /// an end of the segment), else None.
     pub fn crossings_and_parity(&self, p: DVec3, q: DVec3) -> (Vec<Crossing>, Option<bool>) {
-        let mut out = Vec::new();
         let (mut odd, mut clean) = (false, true);
+        let out = self.collect_crossings(p, q, |[a, b, c]| match proper_crossing(p, q, a, b, c) {
+            Crossed::Yes => odd = !odd,
+            _ => clean = false,
+        });
+        (out, clean.then_some(odd))
+    }
+
+    /// The crossings of [p, q], sorted; `met` sees the corners of each triangle met.
+    fn collect_crossings(
+        &self,
+        p: DVec3,
+        q: DVec3,
+        mut met: impl FnMut([DVec3; 3]),
+    ) -> Vec<Crossing> {
+        let mut out = Vec::new();
         self.visit_segment(p, q, |t| {
             if self.flat[t as usize] {
                 return;
@@ -312,14 +310,11 @@ impl<'a> SurfaceOracle<'a> {
                     t: t_param,
                     point: p + (q - p) * t_param,
                 });
-                match proper_crossing(p, q, a, b, c) {
-                    Crossed::Yes => odd = !odd,
-                    _ => clean = false,
-                }
+                met([a, b, c]);
             }
         });
         out.sort_by(|x, y| x.t.total_cmp(&y.t).then(x.triangle.cmp(&y.triangle)));
-        (out, clean.then_some(odd))
+        out
     }
 
     /// Inside, outside or on the closed surface, by the parity of proper crossings of a ray;

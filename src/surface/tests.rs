@@ -205,6 +205,16 @@ fn hinted_distance_queries_match_plain_ones() {
     }
 }
 
+/// Every triangle of `s` the segment [p, q] meets, by testing them all.
+fn brute_crossings(s: &InputSurface, p: DVec3, q: DVec3) -> Vec<u32> {
+    (0..s.triangles.len() as u32)
+        .filter(|&t| {
+            let [a, b, c] = s.corners(t as usize);
+            crate::plc::exact::segment_meets_triangle(p, q, a, b, c)
+        })
+        .collect()
+}
+
 #[test]
 fn segment_crossings_match_brute_force() {
     let s = model_surface("off/joint.off");
@@ -220,13 +230,7 @@ fn segment_crossings_match_brute_force() {
         let (p, q) = (pick(), pick());
         let mut fast: Vec<u32> = o.crossings(p, q).iter().map(|c| c.triangle).collect();
         fast.sort_unstable();
-        let brute: Vec<u32> = (0..s.triangles.len() as u32)
-            .filter(|&t| {
-                let [a, b, c] = s.corners(t as usize);
-                crate::plc::exact::segment_meets_triangle(p, q, a, b, c)
-            })
-            .collect();
-        assert_eq!(fast, brute);
+        assert_eq!(fast, brute_crossings(&s, p, q));
         for c in o.crossings(p, q) {
             let [a, b, cc] = s.corners(c.triangle as usize);
             let gap = (closest_on_triangle(c.point, a, b, cc) - c.point).length();
@@ -255,13 +259,7 @@ fn short_segment_crossings_and_parity_match_brute_force() {
             let (found, parity) = o.crossings_and_parity(p, q);
             let mut fast: Vec<u32> = found.iter().map(|c| c.triangle).collect();
             fast.sort_unstable();
-            let brute: Vec<u32> = (0..s.triangles.len() as u32)
-                .filter(|&t| {
-                    let [a, b, c] = s.corners(t as usize);
-                    crate::plc::exact::segment_meets_triangle(p, q, a, b, c)
-                })
-                .collect();
-            assert_eq!(fast, brute, "{name}: {p} {q}");
+            assert_eq!(fast, brute_crossings(&s, p, q), "{name}: {p} {q}");
             if let Some(odd) = parity {
                 clean += 1;
                 let sides = (o.side(p), o.side(q));

@@ -70,6 +70,17 @@ impl SurfaceMesher<'_> {
         self.track.centre.get(t as usize).copied().flatten()
     }
 
+    /// Whether a tet with circumcentre `centre` is inside, given the side of the tet across a
+    /// face and the crossing parity of the segment between their circumcentres (None: not
+    /// clean, or a centre missing; a ray decides). A flat tet (no centre) is outside.
+    fn side_across(&self, other_inside: bool, centre: Option<DVec3>, parity: Option<bool>) -> bool {
+        match (centre, parity) {
+            (None, _) => false,
+            (Some(_), Some(odd)) => other_inside != odd,
+            (Some(c), None) => self.oracle.side(c) != Side::Outside,
+        }
+    }
+
     /// After inserting `new_vertex`: the restricted facets of the removed tets go; the created
     /// tets get their circumcentre and side, their faces are checked (each Voronoi edge crossed
     /// once) and the bad restricted facets queued.
@@ -120,11 +131,8 @@ impl SurfaceMesher<'_> {
                     _ => (vec![], None),
                 };
                 if outer {
-                    track.inside[t as usize] = match (c, parity) {
-                        (None, _) => false,
-                        (Some(_), Some(odd)) => track.inside[n as usize] != odd,
-                        (Some(c), None) => self.oracle.side(c) != Side::Outside,
-                    };
+                    track.inside[t as usize] =
+                        self.side_across(track.inside[n as usize], c, parity);
                 }
                 let face = FACE[i].map(|k| tv[k]);
                 if let Some(r) = Self::facet_from(&self.dt, face, crossings) {
@@ -181,11 +189,7 @@ impl SurfaceMesher<'_> {
                 };
                 if !reached[n as usize] {
                     reached[n as usize] = true;
-                    out.inside[n as usize] = match (cn, parity) {
-                        (None, _) => false,
-                        (Some(_), Some(odd)) => out.inside[t as usize] != odd,
-                        (Some(cn), None) => self.oracle.side(cn) != Side::Outside,
-                    };
+                    out.inside[n as usize] = self.side_across(out.inside[t as usize], cn, parity);
                     queue.push_back(n);
                 }
                 let face = FACE[i].map(|k| tv[k]);

@@ -16,9 +16,9 @@ use crate::delaunay::tables::FACE;
 use crate::delaunay::{Inserted, Probe, INFINITE};
 use crate::geom::circumsphere;
 use crate::geom::screen::{shortest_edge_sq, sliver_measures, SliverScreen};
-use crate::refine::{AutoSpacing, Spacing};
+use crate::refine::{random_in_unit_ball, AutoSpacing, Spacing};
 use glam::DVec3;
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rustc_hash::FxHashMap;
 use std::collections::VecDeque;
@@ -345,19 +345,9 @@ impl SurfaceMesher<'_> {
     }
 
     fn random_in_ball(&mut self) -> DVec3 {
-        let Some(vol) = self.vol.as_mut() else {
-            return DVec3::ZERO;
-        };
-        loop {
-            let v = DVec3::new(
-                vol.rng.gen_range(-1.0..1.0),
-                vol.rng.gen_range(-1.0..1.0),
-                vol.rng.gen_range(-1.0..1.0),
-            );
-            if v.length_squared() <= 1.0 {
-                return v;
-            }
-        }
+        self.vol
+            .as_mut()
+            .map_or(DVec3::ZERO, |vol| random_in_unit_ball(&mut vol.rng))
     }
 
     /// The small slivers (circumradius <= `max_r`) inserting the last probed point `p` would
