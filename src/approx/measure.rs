@@ -25,10 +25,9 @@ pub(super) fn hausdorff_samples(surface: &InputSurface) -> Vec<DVec3> {
     samples_per_edge_at_least(surface, spacing, MIN_PIECES)
 }
 
-/// Largest distance from samples of `from` to `to` (spacing as [`hausdorff_samples`], by
-/// `from`'s own diagonal).
-fn one_sided(from: &InputSurface, to: &InputSurface) -> f64 {
-    let oracle = SurfaceOracle::new(to);
+/// Largest distance from samples of `from` to the surface behind `oracle` (spacing as
+/// [`hausdorff_samples`], by `from`'s own diagonal).
+fn one_sided(from: &InputSurface, oracle: &SurfaceOracle) -> f64 {
     let mut worst: f64 = 0.0;
     // Consecutive samples come from one triangle: the last triangle found is tried first.
     let mut hint = None;
@@ -43,7 +42,8 @@ fn one_sided(from: &InputSurface, to: &InputSurface) -> f64 {
 /// Points per input feature edge where its distance to the output's feature edges is taken.
 const FEATURE_EDGE_SAMPLES: usize = 8;
 
-pub fn surface_report(r: &Remeshed, mesh: &TetMesh) -> SurfaceReport {
+/// The surface figures of `mesh`; `input` is the oracle of `r.surface` (the caller has one).
+pub fn surface_report(r: &Remeshed, input: &SurfaceOracle, mesh: &TetMesh) -> SurfaceReport {
     // The output boundary: the remeshed triangles where the improvement left their vertices.
     let out = output_surface(mesh);
     let out_volume: f64 = mesh
@@ -56,8 +56,8 @@ pub fn surface_report(r: &Remeshed, mesh: &TetMesh) -> SurfaceReport {
         .sum();
     SurfaceReport {
         surface_distance: r.distance,
-        hausdorff_input_to_output: one_sided(&r.surface, &out),
-        hausdorff_output_to_input: one_sided(&out, &r.surface),
+        hausdorff_input_to_output: one_sided(&r.surface, &SurfaceOracle::new(&out)),
+        hausdorff_output_to_input: one_sided(&out, input),
         feature_distance: feature_distance(r, &mesh.vertices),
         relative_volume_difference: if r.input_volume > 0.0 {
             (out_volume - r.input_volume) / r.input_volume

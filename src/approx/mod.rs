@@ -94,7 +94,7 @@ pub fn mesh(
         distance: DISTANCE_SAFETY * remeshed.distance,
     };
     let mesh = crate::improve::finish(mesh, &mut report, None, params, Some(&slide))?;
-    let mut surface_report = measure::surface_report(&remeshed, &mesh);
+    let mut surface_report = measure::surface_report(&remeshed, &oracle, &mesh);
     if report.stop_reason.is_none() {
         report.stop_reason = remeshed.stop_reason.clone();
     }
