@@ -1,6 +1,5 @@
 //! Two-sided Hausdorff distance between triangle surfaces, by dense sampling: every triangle
-//! is sampled on a barycentric grid fine enough that no point of it is farther than `spacing`
-//! from a sample, and each sample's distance to the other surface is exact up to rounding
+//! is sampled finely enough that no point of it is farther than `spacing` from a sample, and each sample's distance to the other surface is exact up to rounding
 //! (closest point through the AABB tree). The result therefore underestimates the true
 //! distance by at most `spacing`.
 
@@ -33,6 +32,11 @@ pub fn samples(s: &InputSurface, spacing: f64) -> Vec<DVec3> {
 
 /// [`samples`], with every triangle's edges cut into at least `min_pieces` (small triangles
 /// still get interior samples, where a curved surface is farthest from them).
+///
+/// A triangle is sampled on a barycentric grid of step at most `spacing` along each edge: no
+/// point of it is farther than `spacing` / sqrt(3) from a sample. A long thin triangle, where
+/// that grid would be mostly redundant points along its length, is sampled in rows instead
+/// (see [`rows`]), with the same guarantee and fewer samples.
 pub fn samples_per_edge_at_least(s: &InputSurface, spacing: f64, min_pieces: usize) -> Vec<DVec3> {
     assert!(spacing > 0.0, "sampling spacing must be positive");
     let mut out = Vec::new();
@@ -40,6 +44,12 @@ pub fn samples_per_edge_at_least(s: &InputSurface, spacing: f64, min_pieces: usi
         let [a, b, c] = s.corners(t);
         let longest = (b - a).length().max((c - b).length()).max((a - c).length());
         let k = ((longest / spacing).ceil() as usize).clamp(min_pieces.max(1), 4096);
+        let grid_samples = (k + 1) * (k + 2) / 2;
+        let rows = Rows::of([a, b, c], spacing / 3f64.sqrt());
+        if k > min_pieces && rows.count() < grid_samples {
+            rows.sample(&mut out);
+            continue;
+        }
         for i in 0..=k {
             for j in 0..=(k - i) {
                 let (u, v) = (i as f64 / k as f64, j as f64 / k as f64);
@@ -48,6 +58,73 @@ pub fn samples_per_edge_at_least(s: &InputSurface, spacing: f64, min_pieces: usi
         }
     }
     out
+}
+
+/// Samples of a triangle along rows parallel to its longest edge `a`-`b`, at most `step`
+/// apart and `step` from the next row, the other two edges sampled as well. A point lies
+/// between two rows, within `step` / 2 of the border of the strip of the triangle between
+/// them, whose every point is within `step` / 2 of a sample: within `step` of a sample in all.
+struct Rows {
+    /// Longest edge first.
+    corners: [DVec3; 3],
+    rows: usize,
+    step: f64,
+}
+
+impl Rows {
+    fn of([a, b, c]: [DVec3; 3], step: f64) -> Rows {
+        let (ab, bc, ca) = ((b - a).length(), (c - b).length(), (a - c).length());
+        let corners = if ab >= bc && ab >= ca {
+            [a, b, c]
+        } else if bc >= ca {
+            [b, c, a]
+        } else {
+            [c, a, b]
+        };
+        let [a, b, c] = corners;
+        let height = (b - a).cross(c - a).length() / (b - a).length().max(f64::MIN_POSITIVE);
+        Rows {
+            corners,
+            rows: ((height / step).ceil() as usize).clamp(1, 4096),
+            step,
+        }
+    }
+
+    /// Steps along a segment of length `len` (at least 1).
+    fn steps(&self, len: f64) -> usize {
+        ((len / self.step).ceil() as usize).clamp(1, 4096)
+    }
+
+    /// The ends of row `j` (row 0 is edge a-b, the last one apex c).
+    fn row(&self, j: usize) -> (DVec3, DVec3) {
+        let [a, b, c] = self.corners;
+        let tau = j as f64 / self.rows as f64;
+        (a + (c - a) * tau, b + (c - b) * tau)
+    }
+
+    fn count(&self) -> usize {
+        let [a, b, c] = self.corners;
+        let along_rows: usize = (0..=self.rows)
+            .map(|j| {
+                let (p, r) = self.row(j);
+                self.steps((r - p).length()) + 1
+            })
+            .sum();
+        along_rows + self.steps((c - a).length()) + self.steps((c - b).length())
+    }
+
+    fn sample(&self, out: &mut Vec<DVec3>) {
+        let [a, b, c] = self.corners;
+        for j in 0..=self.rows {
+            let (p, r) = self.row(j);
+            let n = self.steps((r - p).length());
+            out.extend((0..=n).map(|i| p + (r - p) * (i as f64 / n as f64)));
+        }
+        for (from, to) in [(a, c), (b, c)] {
+            let n = self.steps((to - from).length());
+            out.extend((1..n).map(|i| from + (to - from) * (i as f64 / n as f64)));
+        }
+    }
 }
 
 /// Largest distance from the samples of `from` to the surface behind `to`, and where.

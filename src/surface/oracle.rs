@@ -40,6 +40,15 @@ struct Node {
     count: u32,
 }
 
+impl Node {
+    fn bounds(&self) -> Aabb {
+        Aabb {
+            lo: self.lo,
+            hi: self.hi,
+        }
+    }
+}
+
 /// The nearest surface point to a query.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Closest {
@@ -73,8 +82,9 @@ pub struct SurfaceOracle<'a> {
     pieces: Vec<Piece>,
     /// Piece ids in leaf order.
     order: Vec<u32>,
-    /// Per leaf position in `order`: the piece's triangle.
+    /// Per leaf position in `order`: the piece's triangle, and its box (padded as the nodes).
     leaf_tri: Vec<u32>,
+    leaf_box: Vec<Aabb>,
     /// Every triangle's corner points, side by side (the queries' innermost loads).
     corners: Vec<[DVec3; 3]>,
     /// Per triangle: the triangles across its three edges (`NO_NEIGHBOUR` on a border or a
@@ -97,6 +107,7 @@ impl<'a> SurfaceOracle<'a> {
             nodes: Vec::with_capacity(2 * pieces.len() / LEAF_SIZE + 1),
             order: (0..pieces.len() as u32).collect(),
             leaf_tri: vec![],
+            leaf_box: vec![],
             corners: (0..n).map(|t| surface.corners(t)).collect(),
             neighbours: edge_neighbours(&surface.triangles),
             grid: Occupancy::new(&pieces, PIECE_FRACTION * diagonal),
@@ -115,6 +126,15 @@ impl<'a> SurfaceOracle<'a> {
             .order
             .iter()
             .map(|&k| o.pieces[k as usize].triangle)
+            .collect();
+        let pad = DVec3::splat(o.pad);
+        o.leaf_box = o
+            .order
+            .iter()
+            .map(|&k| Aabb {
+                lo: o.pieces[k as usize].lo - pad,
+                hi: o.pieces[k as usize].hi + pad,
+            })
             .collect();
         o
     }
@@ -275,7 +295,7 @@ impl<'a> SurfaceOracle<'a> {
 
     /// Every triangle the closed segment [p, q] meets, ordered by parameter then triangle id.
     pub fn crossings(&self, p: DVec3, q: DVec3) -> Vec<Crossing> {
-        self.collect_crossings(p, q, |_| {})
+        self.crossings_and_parity(p, q).0
     }
 
     /// [`Self::crossings`], and whether p and q lie on different sides of the closed surface
@@ -283,38 +303,27 @@ impl<'a> SurfaceOracle<'a> {
     /// an end of the segment), else None.
     pub fn crossings_and_parity(&self, p: DVec3, q: DVec3) -> (Vec<Crossing>, Option<bool>) {
         let (mut odd, mut clean) = (false, true);
-        let out = self.collect_crossings(p, q, |[a, b, c]| match proper_crossing(p, q, a, b, c) {
-            Crossed::Yes => odd = !odd,
-            _ => clean = false,
-        });
-        (out, clean.then_some(odd))
-    }
-
-    /// The crossings of [p, q], sorted; `met` sees the corners of each triangle met.
-    fn collect_crossings(
-        &self,
-        p: DVec3,
-        q: DVec3,
-        mut met: impl FnMut([DVec3; 3]),
-    ) -> Vec<Crossing> {
         let mut out = Vec::new();
         self.visit_segment(p, q, |t| {
             if self.flat[t as usize] {
                 return;
             }
             let [a, b, c] = self.corners[t as usize];
-            if segment_meets_triangle(p, q, a, b, c) {
-                let t_param = crossing_parameter(p, q, a, b, c);
+            if let Some((t_param, proper)) = segment_meets(p, q, a, b, c) {
                 out.push(Crossing {
                     triangle: t,
                     t: t_param,
                     point: p + (q - p) * t_param,
                 });
-                met([a, b, c]);
+                if proper {
+                    odd = !odd;
+                } else {
+                    clean = false;
+                }
             }
         });
         out.sort_by(|x, y| x.t.total_cmp(&y.t).then(x.triangle.cmp(&y.triangle)));
-        out
+        (out, clean.then_some(odd))
     }
 
     /// Inside, outside or on the closed surface, by the parity of proper crossings of a ray;
@@ -377,12 +386,16 @@ impl<'a> SurfaceOracle<'a> {
         while top > 0 {
             top -= 1;
             let node = &self.nodes[stack[top]];
-            if !segment_hits_box(node, &slab) {
+            if !segment_hits_box(&node.bounds(), &slab) {
                 continue;
             }
             if node.count > 0 {
-                for &t in self.leaf_triangles(node) {
-                    if seen.insert(t) {
+                let range = node.first as usize..(node.first + node.count) as usize;
+                for (&t, b) in self.leaf_tri[range.clone()]
+                    .iter()
+                    .zip(&self.leaf_box[range])
+                {
+                    if segment_hits_box(b, &slab) && seen.insert(t) {
                         f(t);
                     }
                 }
@@ -682,10 +695,38 @@ fn is_flat([a, b, c]: [DVec3; 3]) -> bool {
     }
 }
 
-/// Where [p, q] meets the plane of (a, b, c), from the two orientation determinants.
-fn crossing_parameter(p: DVec3, q: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
+/// Whether the closed segment [p, q] meets triangle (a, b, c) (exact) and if so where, as
+/// a parameter along it, and whether the crossing is proper: through the triangle's interior
+/// with both ends off its plane.
+fn segment_meets(p: DVec3, q: DVec3, a: DVec3, b: DVec3, c: DVec3) -> Option<(f64, bool)> {
     let dp = orient3d(a, b, c, p);
     let dq = orient3d(a, b, c, q);
+    let (sp, sq) = (crate::geom::sign(dp), crate::geom::sign(dq));
+    let meets = match (sp, sq) {
+        (Ordering::Equal, Ordering::Equal) => segment_meets_triangle(p, q, a, b, c),
+        (Ordering::Equal, _) => point_in_triangle_3d(p, a, b, c),
+        (_, Ordering::Equal) => point_in_triangle_3d(q, a, b, c),
+        _ if sp == sq => false,
+        _ => {
+            let o = [
+                crate::geom::sign(orient3d(p, q, a, b)),
+                crate::geom::sign(orient3d(p, q, b, c)),
+                crate::geom::sign(orient3d(p, q, c, a)),
+            ];
+            let has = |s| o.contains(&s);
+            if has(Ordering::Less) && has(Ordering::Greater) {
+                false
+            } else {
+                let proper = !has(Ordering::Equal);
+                return Some(((dp / (dp - dq)).clamp(0.0, 1.0), proper));
+            }
+        }
+    };
+    meets.then(|| (crossing_parameter(p, q, a, b, c, dp, dq), false))
+}
+
+/// Where [p, q] meets the plane of (a, b, c), from the two orientation determinants.
+fn crossing_parameter(p: DVec3, q: DVec3, a: DVec3, b: DVec3, c: DVec3, dp: f64, dq: f64) -> f64 {
     if dp == dq {
         // Coplanar segment: the middle of its overlap is a fair representative.
         let mid = closest_on_triangle((p + q) / 2.0, a, b, c);
@@ -723,11 +764,18 @@ impl Slab {
     }
 }
 
+/// An axis-aligned box.
+#[derive(Debug, Clone, Copy)]
+struct Aabb {
+    lo: DVec3,
+    hi: DVec3,
+}
+
 /// Slab test of a segment against a (padded) box; conservative.
-fn segment_hits_box(node: &Node, s: &Slab) -> bool {
+fn segment_hits_box(bx: &Aabb, s: &Slab) -> bool {
     let (mut t0, mut t1) = (0.0f64, 1.0f64);
     for k in 0..3 {
-        let (lo, hi, o, dk) = (node.lo[k], node.hi[k], s.p[k], s.d[k]);
+        let (lo, hi, o, dk) = (bx.lo[k], bx.hi[k], s.p[k], s.d[k]);
         if dk == 0.0 {
             if o < lo || o > hi {
                 return false;

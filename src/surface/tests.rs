@@ -348,3 +348,43 @@ fn hausdorff_of_known_shapes() {
         assert!(near <= 0.1);
     }
 }
+
+#[test]
+fn samples_cover_thin_and_fat_triangles() {
+    // Every point of every triangle lies within spacing / sqrt(3) of a sample, whichever
+    // layout (grid or rows) a triangle gets; thin CAD strips get far fewer samples than a
+    // grid over their longest edge would take.
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let spacing = 0.05;
+    for case in 0..40 {
+        let a = DVec3::ZERO;
+        let b = DVec3::new(1.0 + rng.gen::<f64>(), 0.0, 0.0);
+        let height = if case % 2 == 0 { 0.02 } else { 1.0 } * rng.gen::<f64>().max(0.05);
+        let c = DVec3::new(rng.gen_range(-0.5..2.5), height, rng.gen_range(-0.1..0.1));
+        let s = InputSurface::from_triangles(vec![a, b, c], vec![[0, 1, 2]]);
+        let pts = samples(&s, spacing);
+        for _ in 0..400 {
+            let (mut u, mut v) = (rng.gen::<f64>(), rng.gen::<f64>());
+            if u + v > 1.0 {
+                (u, v) = (1.0 - u, 1.0 - v);
+            }
+            let x = a + (b - a) * u + (c - a) * v;
+            let near = pts
+                .iter()
+                .map(|p| (*p - x).length())
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                near <= spacing / 3f64.sqrt() * (1.0 + 1e-9),
+                "case {case}: {near}"
+            );
+        }
+        if case % 2 == 0 {
+            let longest = (b - a).length().max((c - b).length()).max((c - a).length());
+            let k = (longest / spacing).ceil();
+            assert!(
+                (pts.len() as f64) < (k + 1.0) * (k + 2.0) / 2.0 / 1.5,
+                "case {case}"
+            );
+        }
+    }
+}
