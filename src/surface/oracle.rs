@@ -15,12 +15,13 @@ use std::cmp::Ordering;
 /// Pieces per leaf.
 const LEAF_SIZE: usize = 4;
 
-/// Triangles are cut (longest edge halved) into pieces no longer than this share of the
-/// bounding-box diagonal, at most [`MAX_PIECES`] each, and the tree is built over the pieces'
-/// boxes: one box around a long thin CAD strip would cover much of the model, and every query
-/// near it would test the triangle (measured on joint: 16 exact tests per segment query).
+/// Triangles are cut into pieces about this share of the bounding-box diagonal across, at
+/// most [`MAX_PIECES`] each, and the tree is built over the pieces' boxes: one box around a
+/// long thin CAD strip would cover much of the model, and every query near it would test the
+/// triangle and walk the boxes above it (measured on joint: 104 boxes per segment query with
+/// pieces made by halving the longest edge, which leaves a thin strip long).
 const PIECE_FRACTION: f64 = 1.0 / 64.0;
-const MAX_PIECES: usize = 64;
+const MAX_PIECES: usize = 1024;
 
 /// A piece of a triangle: only its box is kept; queries test the whole triangle.
 #[derive(Debug, Clone, Copy)]
@@ -30,23 +31,20 @@ struct Piece {
     hi: DVec3,
 }
 
+/// An axis-aligned box.
 #[derive(Debug, Clone, Copy)]
-struct Node {
+struct Aabb {
     lo: DVec3,
     hi: DVec3,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    bounds: Aabb,
     /// Leaf: first index into `order`; inner node: index of the left child (right = left + 1).
     first: u32,
     /// Leaf: number of triangles (> 0); inner node: 0.
     count: u32,
-}
-
-impl Node {
-    fn bounds(&self) -> Aabb {
-        Aabb {
-            lo: self.lo,
-            hi: self.hi,
-        }
-    }
 }
 
 /// The nearest surface point to a query.
@@ -147,8 +145,10 @@ impl<'a> SurfaceOracle<'a> {
             hi = hi.max(self.pieces[k as usize].hi);
         }
         Node {
-            lo: lo - DVec3::splat(self.pad),
-            hi: hi + DVec3::splat(self.pad),
+            bounds: Aabb {
+                lo: lo - DVec3::splat(self.pad),
+                hi: hi + DVec3::splat(self.pad),
+            },
             first: first as u32,
             count: count as u32,
         }
@@ -163,7 +163,7 @@ impl<'a> SurfaceOracle<'a> {
             if count <= LEAF_SIZE {
                 continue;
             }
-            let extent = node.hi - node.lo;
+            let extent = node.bounds.hi - node.bounds.lo;
             let axis = if extent.x >= extent.y && extent.x >= extent.z {
                 0
             } else if extent.y >= extent.z {
@@ -386,7 +386,7 @@ impl<'a> SurfaceOracle<'a> {
         while top > 0 {
             top -= 1;
             let node = &self.nodes[stack[top]];
-            if !segment_hits_box(&node.bounds(), &slab) {
+            if !segment_hits_box(&node.bounds, &slab) {
                 continue;
             }
             if node.count > 0 {
@@ -581,41 +581,95 @@ impl Occupancy {
     }
 }
 
-/// Every triangle cut by halving its longest edge until the pieces are at most `len` long (at
-/// most [`MAX_PIECES`] per triangle), as boxes.
+/// Every triangle cut into pieces about `len` across (at most [`MAX_PIECES`] each), as
+/// boxes: strips parallel to its longest edge `len` apart, each cut every `len` along that
+/// edge. The boxes only need to cover the triangle: they are padded like the nodes.
 fn cut_into_pieces(surface: &InputSurface, len: f64) -> Vec<Piece> {
     let mut pieces = Vec::with_capacity(surface.triangles.len());
-    let mut work = vec![];
+    let mut polygon = Vec::with_capacity(8);
     for t in 0..surface.triangles.len() {
-        work.clear();
-        work.push(surface.corners(t));
-        let mut done = 0;
-        while let Some([a, b, c]) = work.pop() {
-            let edges = [(b - a).length(), (c - b).length(), (a - c).length()];
-            let longest = edges[0].max(edges[1]).max(edges[2]);
-            if longest <= len || done + work.len() + 2 > MAX_PIECES {
-                pieces.push(Piece {
-                    triangle: t as u32,
-                    lo: a.min(b).min(c),
-                    hi: a.max(b).max(c),
-                });
-                done += 1;
-                continue;
+        let [a, b, c] = longest_edge_first(surface.corners(t));
+        let long = (b - a).length();
+        let height = (b - a).cross(c - a).length() / long.max(f64::MIN_POSITIVE);
+        let count = |step: f64| {
+            let n = |x: f64| ((x / step).ceil() as usize).max(1);
+            (n(height), n(long))
+        };
+        let mut step = if len > 0.0 {
+            len
+        } else {
+            long.max(height).max(f64::MIN_POSITIVE)
+        };
+        while count(step).0 * count(step).1 > MAX_PIECES {
+            step *= 1.25;
+        }
+        let (rows, slices) = count(step);
+        let along = (b - a) / long.max(f64::MIN_POSITIVE);
+        let row = |j: usize| {
+            let tau = j as f64 / rows as f64;
+            (a + (c - a) * tau, b + (c - b) * tau)
+        };
+        for j in 0..rows {
+            let ((p0, r0), (p1, r1)) = (row(j), row(j + 1));
+            for i in 0..slices {
+                // The outer slices reach past the triangle: rounding never leaves a part out.
+                let from = if i == 0 {
+                    f64::NEG_INFINITY
+                } else {
+                    i as f64 * long / slices as f64
+                };
+                let to = if i + 1 == slices {
+                    f64::INFINITY
+                } else {
+                    (i + 1) as f64 * long / slices as f64
+                };
+                polygon.clear();
+                polygon.extend([p0, r0, r1, p1]);
+                clip(&mut polygon, |x| (x - a).dot(along) - from);
+                clip(&mut polygon, |x| to - (x - a).dot(along));
+                if let Some(&first) = polygon.first() {
+                    let (lo, hi) = polygon
+                        .iter()
+                        .fold((first, first), |(lo, hi), &x| (lo.min(x), hi.max(x)));
+                    pieces.push(Piece {
+                        triangle: t as u32,
+                        lo,
+                        hi,
+                    });
+                }
             }
-            let halves = if edges[0] == longest {
-                let m = (a + b) / 2.0;
-                [[a, m, c], [m, b, c]]
-            } else if edges[1] == longest {
-                let m = (b + c) / 2.0;
-                [[a, b, m], [a, m, c]]
-            } else {
-                let m = (c + a) / 2.0;
-                [[a, b, m], [m, b, c]]
-            };
-            work.extend(halves);
         }
     }
     pieces
+}
+
+/// The corners turned so that the first edge is the longest.
+fn longest_edge_first([a, b, c]: [DVec3; 3]) -> [DVec3; 3] {
+    let (ab, bc, ca) = ((b - a).length(), (c - b).length(), (a - c).length());
+    if ab >= bc && ab >= ca {
+        [a, b, c]
+    } else if bc >= ca {
+        [b, c, a]
+    } else {
+        [c, a, b]
+    }
+}
+
+/// Keeps the part of convex `polygon` where `side` is not negative (Sutherland-Hodgman).
+fn clip(polygon: &mut Vec<DVec3>, side: impl Fn(DVec3) -> f64) {
+    let n = polygon.len();
+    let mut out = Vec::with_capacity(n + 2);
+    for k in 0..n {
+        let (x, y) = (polygon[k], polygon[(k + 1) % n]);
+        let (sx, sy) = (side(x), side(y));
+        if sx >= 0.0 {
+            out.push(x);
+        }
+        if (sx >= 0.0) != (sy >= 0.0) {
+            out.push(x + (y - x) * (sx / (sx - sy)));
+        }
+    }
+    *polygon = out;
 }
 
 /// Ray directions tried before giving up (each a generic direction; grazing rays are rare).
@@ -742,7 +796,9 @@ fn crossing_parameter(p: DVec3, q: DVec3, a: DVec3, b: DVec3, c: DVec3, dp: f64,
 }
 
 fn box_distance(node: &Node, p: DVec3) -> f64 {
-    let d = (node.lo - p).max(p - node.hi).max(DVec3::ZERO);
+    let d = (node.bounds.lo - p)
+        .max(p - node.bounds.hi)
+        .max(DVec3::ZERO);
     d.length()
 }
 
@@ -751,6 +807,8 @@ struct Slab {
     p: DVec3,
     d: DVec3,
     inv: DVec3,
+    /// Some coordinate of the direction is zero: the general test would meet 0 * inf.
+    axis_parallel: bool,
 }
 
 impl Slab {
@@ -760,19 +818,24 @@ impl Slab {
             p,
             d,
             inv: DVec3::ONE / d,
+            axis_parallel: d.cmpeq(DVec3::ZERO).any(),
         }
     }
 }
 
-/// An axis-aligned box.
-#[derive(Debug, Clone, Copy)]
-struct Aabb {
-    lo: DVec3,
-    hi: DVec3,
-}
-
 /// Slab test of a segment against a (padded) box; conservative.
 fn segment_hits_box(bx: &Aabb, s: &Slab) -> bool {
+    if s.axis_parallel {
+        return segment_hits_box_axis_parallel(bx, s);
+    }
+    let (a, b) = ((bx.lo - s.p) * s.inv, (bx.hi - s.p) * s.inv);
+    let t0 = a.min(b).max_element().max(0.0);
+    let t1 = a.max(b).min_element().min(1.0);
+    t0 <= t1 * (1.0 + 1e-12) + 1e-300
+}
+
+/// [`segment_hits_box`] for a segment parallel to a coordinate plane.
+fn segment_hits_box_axis_parallel(bx: &Aabb, s: &Slab) -> bool {
     let (mut t0, mut t1) = (0.0f64, 1.0f64);
     for k in 0..3 {
         let (lo, hi, o, dk) = (bx.lo[k], bx.hi[k], s.p[k], s.d[k]);
