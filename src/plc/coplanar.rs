@@ -127,7 +127,11 @@ impl Plane {
         let pts: Vec<DVec3> = p.iter().map(|&v| verts[v as usize]).collect();
         let a = pts[0];
         let b = *pts.iter().find(|&&q| q != a)?;
-        let c = *pts.iter().find(|&&q| !collinear(a, b, q))?;
+        // a and b themselves are collinear with a and b: testing them would take the exact
+        // predicate's slow path (a zero determinant is never clear to the fast filter).
+        let c = *pts
+            .iter()
+            .find(|&&q| q != a && q != b && !collinear(a, b, q))?;
         let plane = Plane {
             a,
             b,
