@@ -15,7 +15,8 @@ use std::cmp::Ordering;
 /// Pieces per leaf.
 const LEAF_SIZE: usize = 4;
 
-/// Triangles are cut into pieces about this share of the bounding-box diagonal across, at
+/// Triangles are cut into pieces one to two times this share of the bounding-box diagonal
+/// across, at
 /// most [`MAX_PIECES`] each, and the tree is built over the pieces' boxes: one box around a
 /// long thin CAD strip would cover much of the model, and every query near it would test the
 /// triangle and walk the boxes above it (measured on joint: 104 boxes per segment query with
@@ -581,9 +582,9 @@ impl Occupancy {
     }
 }
 
-/// Every triangle cut into pieces about `len` across (at most [`MAX_PIECES`] each), as
-/// boxes: strips parallel to its longest edge `len` apart, each cut every `len` along that
-/// edge. The boxes only need to cover the triangle: they are padded like the nodes.
+/// Every triangle cut into pieces `len` to 2 `len` across (at most [`MAX_PIECES`] each), as
+/// boxes: strips parallel to its longest edge, each cut across along that edge (a triangle
+/// under 2 `len` stays whole: smaller pieces only make the tree deeper). The boxes only need to cover the triangle: they are padded like the nodes.
 fn cut_into_pieces(surface: &InputSurface, len: f64) -> Vec<Piece> {
     let mut pieces = Vec::with_capacity(surface.triangles.len());
     let mut polygon = Vec::with_capacity(8);
@@ -592,7 +593,7 @@ fn cut_into_pieces(surface: &InputSurface, len: f64) -> Vec<Piece> {
         let long = (b - a).length();
         let height = (b - a).cross(c - a).length() / long.max(f64::MIN_POSITIVE);
         let count = |step: f64| {
-            let n = |x: f64| ((x / step).ceil() as usize).max(1);
+            let n = |x: f64| ((x / step).floor() as usize).max(1);
             (n(height), n(long))
         };
         let mut step = if len > 0.0 {
