@@ -164,6 +164,12 @@ pub fn triangle_contact(ti: [u32; 3], t: [DVec3; 3], si: [u32; 3], s: [DVec3; 3]
         .collect();
     // Rotate so the shared vertices come first (cyclic rotations keep orientation).
     let rot = |first: usize| [first, (first + 1) % 3, (first + 2) % 3];
+    // Most pairs the broad phase passes are separated by one of the two planes (apart from
+    // the vertices they share): two or three orientations settle them.
+    if shared.len() < 2 && (strictly_one_side(t, s, &si, &ti) || strictly_one_side(s, t, &ti, &si))
+    {
+        return Contact::Clean;
+    }
     match shared.len() {
         0 => {
             let hit = (0..3)
@@ -211,6 +217,29 @@ pub fn triangle_contact(ti: [u32; 3], t: [DVec3; 3], si: [u32; 3], s: [DVec3; 3]
         }
         _ => Contact::Clash,
     }
+}
+
+/// Whether the corners of `other` that are not corners of `plane_of` (by index: `other_ids`
+/// against `plane_ids`) all lie strictly on one side of the plane of `plane_of`.
+fn strictly_one_side(
+    plane_of: [DVec3; 3],
+    other: [DVec3; 3],
+    other_ids: &[u32; 3],
+    plane_ids: &[u32; 3],
+) -> bool {
+    let [a, b, c] = plane_of;
+    let mut side = None;
+    for k in 0..3 {
+        if plane_ids.contains(&other_ids[k]) {
+            continue;
+        }
+        let o = orient3(a, b, c, other[k]);
+        if o == Ordering::Equal || side.is_some_and(|s| s != o) {
+            return false;
+        }
+        side = Some(o);
+    }
+    side.is_some()
 }
 
 #[cfg(test)]

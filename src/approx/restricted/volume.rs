@@ -320,7 +320,7 @@ impl SurfaceMesher<'_> {
         let Some(crit) = self.vol.as_ref().map(|v| v.crit) else {
             return centre;
         };
-        let mut best = (self.small_slivers(centre, crit.b * r), centre);
+        let mut best = (self.small_slivers(centre, crit.b * r, usize::MAX), centre);
         if best.0 .0 == 0 {
             return centre;
         }
@@ -329,7 +329,7 @@ impl SurfaceMesher<'_> {
             if let Probe::Duplicate(_) = self.dt.probe(q, Some(t)) {
                 continue;
             }
-            let score = self.small_slivers(q, crit.b * r);
+            let score = self.small_slivers(q, crit.b * r, best.0 .0);
             if score >= best.0 {
                 continue;
             }
@@ -351,8 +351,9 @@ impl SurfaceMesher<'_> {
     }
 
     /// The small slivers (circumradius <= `max_r`) inserting the last probed point `p` would
-    /// create, and the largest cosine of a smallest dihedral angle among them.
-    fn small_slivers(&self, p: DVec3, max_r: f64) -> (usize, f64) {
+    /// create, and the largest cosine of a smallest dihedral angle among them; the count stops
+    /// once it passes `enough` (the point is then no better than one already found).
+    fn small_slivers(&self, p: DVec3, max_r: f64, enough: usize) -> (usize, f64) {
         let Some(vol) = self.vol.as_ref() else {
             return (0, -1.0);
         };
@@ -375,6 +376,9 @@ impl SurfaceMesher<'_> {
             {
                 n += 1;
                 worst = worst.max(max_cos);
+                if n > enough {
+                    break;
+                }
             }
         }
         (n, worst)
