@@ -101,15 +101,16 @@ impl<'a> SurfaceOracle<'a> {
         let n = surface.triangles.len();
         let diagonal = surface.bbox_diagonal();
         let pieces = cut_into_pieces(surface, PIECE_FRACTION * diagonal);
+        let corners: Vec<[DVec3; 3]> = (0..n).map(|t| surface.corners(t)).collect();
         let mut o = SurfaceOracle {
             surface: std::marker::PhantomData,
             nodes: Vec::with_capacity(2 * pieces.len() / LEAF_SIZE + 1),
             order: (0..pieces.len() as u32).collect(),
             leaf_tri: vec![],
             leaf_box: vec![],
-            corners: (0..n).map(|t| surface.corners(t)).collect(),
             neighbours: edge_neighbours(&surface.triangles),
-            grid: Occupancy::new(&pieces, PIECE_FRACTION * diagonal),
+            grid: Occupancy::new(&pieces, &corners, GRID_FRACTION * diagonal),
+            corners,
             pieces,
             flat: (0..n).map(|t| is_flat(surface.corners(t))).collect(),
             pad: 1e-9 * diagonal.max(f64::MIN_POSITIVE),
@@ -460,9 +461,10 @@ impl SeenTriangles {
     }
 }
 
-/// Which cells of a uniform grid a piece box touches: a short segment whose box touches none
-/// meets no triangle, answered without walking the tree (most Voronoi edges of a volume mesh
-/// lie far from the surface).
+/// Which cells of a uniform grid may hold part of the surface (the cell, slightly widened,
+/// meets a piece's box and its triangle's plane): a short segment whose box touches no such
+/// cell meets no triangle, answered without walking the tree (most Voronoi edges of a volume
+/// mesh lie off the surface).
 struct Occupancy {
     origin: DVec3,
     cell: f64,
@@ -471,10 +473,13 @@ struct Occupancy {
 }
 
 /// Segments whose box spans more cells than this along an axis walk the tree directly.
-const GRID_SPAN: usize = 3;
+const GRID_SPAN: usize = 6;
+
+/// Grid cells are this share of the bounding-box diagonal.
+const GRID_FRACTION: f64 = 1.0 / 128.0;
 
 impl Occupancy {
-    fn new(pieces: &[Piece], cell: f64) -> Occupancy {
+    fn new(pieces: &[Piece], corners: &[[DVec3; 3]], cell: f64) -> Occupancy {
         let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
         for p in pieces {
             lo = lo.min(p.lo);
@@ -508,12 +513,22 @@ impl Occupancy {
             bits: vec![0; (dims[0] * dims[1] * dims[2]).div_ceil(64)],
         };
         for p in pieces {
-            let (a, b) = (g.index(p.lo, -1), g.index(p.hi, 1));
-            for k in a[2]..=b[2] {
-                for j in a[1]..=b[1] {
-                    for i in a[0]..=b[0] {
-                        let c = (k * dims[1] + j) * dims[0] + i;
-                        g.bits[c / 64] |= 1 << (c % 64);
+            let [a, b, c] = corners[p.triangle as usize];
+            let normal = (b - a).cross(c - a);
+            // A cell is marked when its box, widened a little, meets the triangle's plane:
+            // rounding in the test is far below the widening.
+            let reach = 0.5 * g.cell * (1.0 + 1e-6) * normal.abs().element_sum();
+            let (lo, hi) = (g.index(p.lo, -1), g.index(p.hi, 1));
+            for k in lo[2]..=hi[2] {
+                for j in lo[1]..=hi[1] {
+                    for i in lo[0]..=hi[0] {
+                        let centre = g.origin
+                            + DVec3::new(i as f64 + 0.5, j as f64 + 0.5, k as f64 + 0.5) * g.cell;
+                        if normal.dot(centre - a).abs() > reach {
+                            continue;
+                        }
+                        let x = (k * dims[1] + j) * dims[0] + i;
+                        g.bits[x / 64] |= 1 << (x % 64);
                     }
                 }
             }
