@@ -36,24 +36,34 @@ pub fn samples(s: &InputSurface, spacing: f64) -> Vec<DVec3> {
 /// A triangle is sampled on a barycentric grid of step at most `spacing` along each edge: no
 /// point of it is farther than `spacing` / sqrt(3) from a sample. A long thin triangle, where
 /// that grid would be mostly redundant points along its length, is sampled in rows instead
-/// (see [`rows`]), with the same guarantee and fewer samples.
+/// (see [`Rows`]), with the same guarantee and fewer samples.
 pub fn samples_per_edge_at_least(s: &InputSurface, spacing: f64, min_pieces: usize) -> Vec<DVec3> {
     assert!(spacing > 0.0, "sampling spacing must be positive");
     let mut out = Vec::new();
+    // A vertex is shared by about six triangles: it is sampled once, by the first of them.
+    let mut vertex_done = vec![false; s.vertices.len()];
     for t in 0..s.triangles.len() {
+        for v in s.triangles[t] {
+            if !std::mem::replace(&mut vertex_done[v as usize], true) {
+                out.push(s.vertices[v as usize]);
+            }
+        }
         let [a, b, c] = s.corners(t);
         let longest = (b - a).length().max((c - b).length()).max((a - c).length());
         let k = ((longest / spacing).ceil() as usize).clamp(min_pieces.max(1), 4096);
         let grid_samples = (k + 1) * (k + 2) / 2;
         let rows = Rows::of([a, b, c], spacing / 3f64.sqrt());
         if k > min_pieces && rows.count() < grid_samples {
-            rows.sample(&mut out);
+            rows.sample_inside(&mut out);
             continue;
         }
         for i in 0..=k {
             for j in 0..=(k - i) {
-                let (u, v) = (i as f64 / k as f64, j as f64 / k as f64);
-                out.push(a + (b - a) * u + (c - a) * v);
+                let corner = (i == 0 || i == k) && j == 0 || (i == 0 && j == k);
+                if !corner {
+                    let (u, v) = (i as f64 / k as f64, j as f64 / k as f64);
+                    out.push(a + (b - a) * u + (c - a) * v);
+                }
             }
         }
     }
@@ -113,12 +123,15 @@ impl Rows {
         along_rows + self.steps((c - a).length()) + self.steps((c - b).length())
     }
 
-    fn sample(&self, out: &mut Vec<DVec3>) {
+    /// The samples other than the three corners.
+    fn sample_inside(&self, out: &mut Vec<DVec3>) {
         let [a, b, c] = self.corners;
-        for j in 0..=self.rows {
+        // The last row is corner c alone.
+        for j in 0..self.rows {
             let (p, r) = self.row(j);
             let n = self.steps((r - p).length());
-            out.extend((0..=n).map(|i| p + (r - p) * (i as f64 / n as f64)));
+            let ends = if j == 0 { 1..n } else { 0..n + 1 };
+            out.extend(ends.map(|i| p + (r - p) * (i as f64 / n as f64)));
         }
         for (from, to) in [(a, c), (b, c)] {
             let n = self.steps((to - from).length());
