@@ -165,6 +165,8 @@ pub struct SurfaceMesher<'a> {
     track: tracking::Tracking,
     /// The cell level, once the surface is good (`run_with_volume`).
     vol: Option<Box<volume::VolumeState>>,
+    /// The small corners' protecting balls: centre and squared radius.
+    small_balls: Vec<(DVec3, f64)>,
 }
 
 /// The surface mesh stops (with a reason) at this many times its initial samples: the
@@ -224,6 +226,10 @@ impl<'a> SurfaceMesher<'a> {
             min_length: 1e-9 * diagonal,
             track: tracking::Tracking::default(),
             vol: None,
+            small_balls: curves
+                .small_corners()
+                .map(|c| (c.point, c.protect_radius * c.protect_radius))
+                .collect(),
         };
         let mut points = far_box(surface, diagonal);
         m.loc = vec![Loc::Far; points.len()];
@@ -462,9 +468,9 @@ impl<'a> SurfaceMesher<'a> {
     }
 
     fn near_small_corner(&self, p: DVec3) -> bool {
-        self.curves
-            .small_corners()
-            .any(|c| (p - c.point).length_squared() < c.protect_radius * c.protect_radius)
+        self.small_balls
+            .iter()
+            .any(|&(c, r2)| (p - c).length_squared() < r2)
     }
 
     fn check_subseg(&mut self, k: [u32; 2]) {

@@ -58,6 +58,8 @@ pub(super) struct VolumeState {
     queues: [VecDeque<(u32, [u32; 4])>; 3],
     deferrals: FxHashMap<[u32; 4], u8>,
     pub(super) spacing: Option<AutoSpacing>,
+    /// Per vertex id: within a small corner's ball (cells there are left as they are).
+    near_small: Vec<bool>,
     /// The caller's progress callback asked to stop.
     cancelled: bool,
     rng: ChaCha8Rng,
@@ -87,13 +89,27 @@ impl SurfaceMesher<'_> {
             queues: Default::default(),
             deferrals: FxHashMap::default(),
             spacing,
+            near_small: vec![],
             cancelled: false,
             rng: ChaCha8Rng::seed_from_u64(crit.seed ^ 0x766f_6c75_6d65),
         }));
+        self.mark_near_small_corners();
         let tets: Vec<u32> = self.dt.finite_tet_ids().collect();
         for t in tets {
             self.queue_cell(t);
         }
+    }
+
+    /// Extends the per-vertex small-corner flags to the vertices inserted since.
+    fn mark_near_small_corners(&mut self) {
+        let Some(mut vol) = self.vol.take() else {
+            return;
+        };
+        for v in vol.near_small.len()..self.dt.num_vertex_ids() {
+            let near = self.near_small_corner(self.dt.point(v as u32));
+            vol.near_small.push(near);
+        }
+        self.vol = Some(vol);
     }
 
     /// The default cell spacing: at each surface vertex the mean length of its boundary
@@ -125,6 +141,7 @@ impl SurfaceMesher<'_> {
     /// After an insertion (cell level on): the created tets are queued when bad.
     pub(super) fn queue_cells(&mut self, created: &[u32]) {
         if self.vol.is_some() {
+            self.mark_near_small_corners();
             for &t in created {
                 self.queue_cell(t);
             }
@@ -151,10 +168,10 @@ impl SurfaceMesher<'_> {
         if tv.contains(&INFINITE) || tv.iter().any(|&v| self.loc[v as usize] == Loc::Far) {
             return None;
         }
-        let [a, b, c, d] = tv.map(|v| self.dt.point(v));
-        if [a, b, c, d].iter().any(|&p| self.near_small_corner(p)) {
+        if tv.iter().any(|&v| vol.near_small[v as usize]) {
             return None;
         }
+        let [a, b, c, d] = tv.map(|v| self.dt.point(v));
         let (centre, r) = circumsphere(a, b, c, d)?;
         let f = match &vol.spacing {
             Some(s) => s.at(centre),
