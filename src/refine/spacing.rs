@@ -23,6 +23,8 @@ pub struct AutoSpacing {
     /// f near them is exact instead of smeared over whole cells (a cluster of tiny edges at an
     /// acute corner must not make a whole cell fine).
     small: Vec<Vec<(DVec3, f64)>>,
+    /// Per cell: some cell among it and its 26 neighbours holds small sizes.
+    small_nearby: Vec<bool>,
 }
 
 impl AutoSpacing {
@@ -69,6 +71,7 @@ impl AutoSpacing {
             dims,
             value: vec![ext / 4.0; n],
             small: vec![vec![]; n],
+            small_nearby: vec![false; n],
         };
         for &(p, hv) in sized {
             let i = s.index(p);
@@ -81,6 +84,7 @@ impl AutoSpacing {
         for list in &mut s.small {
             prune_dominated(list);
         }
+        s.mark_small_nearby();
         s.propagate();
         s
     }
@@ -101,9 +105,41 @@ impl AutoSpacing {
 
     /// Two chamfer sweeps (forward, backward) over the 26-neighbourhood enforce
     /// f(x) <= f(y) + ALPHA |x - y| between neighbouring cells.
+    fn mark_small_nearby(&mut self) {
+        let [nx, ny, nz] = self.dims;
+        for k in 0..nz {
+            for j in 0..ny {
+                for i in 0..nx {
+                    if self.small[(k * ny + j) * nx + i].is_empty() {
+                        continue;
+                    }
+                    for c in k.saturating_sub(1)..(k + 2).min(nz) {
+                        for b in j.saturating_sub(1)..(j + 2).min(ny) {
+                            for a in i.saturating_sub(1)..(i + 2).min(nx) {
+                                self.small_nearby[(c * ny + b) * nx + a] = true;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
     fn propagate(&mut self) {
         let [nx, ny, nz] = self.dims;
         let idx = |i: usize, j: usize, k: usize| (k * ny + j) * nx + i;
+        // The 27 offsets and what stepping along each adds, computed once.
+        let mut steps = [(0i64, 0i64, 0i64, 0.0f64); 27];
+        let mut n = 0;
+        for dk in -1i64..=1 {
+            for dj in -1i64..=1 {
+                for di in -1i64..=1 {
+                    let d = ((di * di + dj * dj + dk * dk) as f64).sqrt() * self.cell;
+                    steps[n] = (di, dj, dk, ALPHA * d);
+                    n += 1;
+                }
+            }
+        }
         for _ in 0..2 {
             for pass in 0..2 {
                 for kk in 0..nz {
@@ -115,28 +151,35 @@ impl AutoSpacing {
                                 (nx - 1 - ii, ny - 1 - jj, nz - 1 - kk)
                             };
                             let mut best = self.value[idx(i, j, k)];
-                            for dk in -1i64..=1 {
-                                for dj in -1i64..=1 {
-                                    for di in -1i64..=1 {
-                                        let (a, b, c) =
-                                            (i as i64 + di, j as i64 + dj, k as i64 + dk);
-                                        if a < 0
-                                            || b < 0
-                                            || c < 0
-                                            || a >= nx as i64
-                                            || b >= ny as i64
-                                            || c >= nz as i64
-                                        {
-                                            continue;
-                                        }
-                                        let d = ((di * di + dj * dj + dk * dk) as f64).sqrt()
-                                            * self.cell;
-                                        best = best.min(
-                                            self.value[idx(a as usize, b as usize, c as usize)]
-                                                + ALPHA * d,
-                                        );
+                            let interior =
+                                i > 0 && j > 0 && k > 0 && i + 1 < nx && j + 1 < ny && k + 1 < nz;
+                            if interior {
+                                // No bounds to check; a plain comparison (no NaN here).
+                                let at = idx(i, j, k) as i64;
+                                for &(di, dj, dk, add) in &steps {
+                                    let x = self.value
+                                        [(at + di + (dj + dk * ny as i64) * nx as i64) as usize]
+                                        + add;
+                                    if x < best {
+                                        best = x;
                                     }
                                 }
+                                self.value[idx(i, j, k)] = best;
+                                continue;
+                            }
+                            for &(di, dj, dk, add) in &steps {
+                                let (a, b, c) = (i as i64 + di, j as i64 + dj, k as i64 + dk);
+                                if a < 0
+                                    || b < 0
+                                    || c < 0
+                                    || a >= nx as i64
+                                    || b >= ny as i64
+                                    || c >= nz as i64
+                                {
+                                    continue;
+                                }
+                                best = best
+                                    .min(self.value[idx(a as usize, b as usize, c as usize)] + add);
                             }
                             self.value[idx(i, j, k)] = best;
                         }
@@ -167,6 +210,9 @@ impl Spacing for AutoSpacing {
         // cell is already within its grading in the centre values.
         let i = self.index(p);
         let mut f = self.value[i] + ALPHA * p.distance(self.centre(i));
+        if !self.small_nearby[i] {
+            return f;
+        }
         let [nx, ny, nz] = self.dims;
         let (ii, jj, kk) = (i % nx, (i / nx) % ny, i / (nx * ny));
         for k in kk.saturating_sub(1)..(kk + 2).min(nz) {

@@ -543,11 +543,13 @@ impl Occupancy {
         let margin = 1e-6 * f64::from(side);
         let mut out = [0usize; 3];
         for k in 0..3 {
-            let v = (f[k] + margin).floor();
-            out[k] = if v.is_nan() || v < 0.0 {
-                0
-            } else {
+            // Truncation is the floor for the non-negative values kept (and a function call
+            // less than `floor` on the baseline x86-64 target); NaN fails the test.
+            let v = f[k] + margin;
+            out[k] = if v > 0.0 {
                 (v as usize).min(self.dims[k] - 1)
+            } else {
+                0
             };
         }
         out
@@ -572,17 +574,25 @@ impl Occupancy {
         if (0..3).any(|k| b[k] - a[k] >= GRID_SPAN) {
             return false;
         }
+        let run = b[0] - a[0] + 1;
         for k in a[2]..=b[2] {
             for j in a[1]..=b[1] {
-                for i in a[0]..=b[0] {
-                    let c = (k * self.dims[1] + j) * self.dims[0] + i;
-                    if self.bits[c / 64] & (1 << (c % 64)) != 0 {
-                        return false;
-                    }
+                if self.any_in_run((k * self.dims[1] + j) * self.dims[0] + a[0], run) {
+                    return false;
                 }
             }
         }
         true
+    }
+
+    /// Whether any of the `len` (at most 64) consecutive cells from `start` is marked.
+    fn any_in_run(&self, start: usize, len: usize) -> bool {
+        let (word, offset) = (start / 64, start % 64);
+        let mask = |n: usize| if n >= 64 { u64::MAX } else { (1u64 << n) - 1 };
+        if (self.bits[word] >> offset) & mask(len) != 0 {
+            return true;
+        }
+        offset + len > 64 && self.bits[word + 1] & mask(offset + len - 64) != 0
     }
 
     /// Whether the box [lo, hi] overlaps the grid's extent.
@@ -823,18 +833,20 @@ struct Slab {
     p: DVec3,
     d: DVec3,
     inv: DVec3,
-    /// Some coordinate of the direction is zero: the general test would meet 0 * inf.
+    /// Some coordinate of the direction is zero (or so tiny that its inverse overflows): the
+    /// general test would meet 0 * inf.
     axis_parallel: bool,
 }
 
 impl Slab {
     fn new(p: DVec3, q: DVec3) -> Slab {
         let d = q - p;
+        let inv = DVec3::ONE / d;
         Slab {
             p,
             d,
-            inv: DVec3::ONE / d,
-            axis_parallel: d.cmpeq(DVec3::ZERO).any(),
+            inv,
+            axis_parallel: !inv.is_finite(),
         }
     }
 }
@@ -844,9 +856,13 @@ fn segment_hits_box(bx: &Aabb, s: &Slab) -> bool {
     if s.axis_parallel {
         return segment_hits_box_axis_parallel(bx, s);
     }
+    // No NaN can arise here (finite boxes, no zero direction), so plain comparisons do (the
+    // NaN-aware f64::min and max cost several instructions each).
     let (a, b) = ((bx.lo - s.p) * s.inv, (bx.hi - s.p) * s.inv);
-    let t0 = a.min(b).max_element().max(0.0);
-    let t1 = a.max(b).min_element().min(1.0);
+    let lt = |x: f64, y: f64| if x < y { x } else { y };
+    let gt = |x: f64, y: f64| if x > y { x } else { y };
+    let t0 = gt(gt(gt(lt(a.x, b.x), lt(a.y, b.y)), lt(a.z, b.z)), 0.0);
+    let t1 = lt(lt(lt(gt(a.x, b.x), gt(a.y, b.y)), gt(a.z, b.z)), 1.0);
     t0 <= t1 * (1.0 + 1e-12) + 1e-300
 }
 
@@ -855,7 +871,8 @@ fn segment_hits_box_axis_parallel(bx: &Aabb, s: &Slab) -> bool {
     let (mut t0, mut t1) = (0.0f64, 1.0f64);
     for k in 0..3 {
         let (lo, hi, o, dk) = (bx.lo[k], bx.hi[k], s.p[k], s.d[k]);
-        if dk == 0.0 {
+        // Along an axis the segment does not (measurably) move, its box is its start.
+        if dk == 0.0 || !s.inv[k].is_finite() {
             if o < lo || o > hi {
                 return false;
             }
