@@ -118,6 +118,44 @@ impl SliverScreen {
         self.clears(det, e, l2, n)
     }
 
+    /// For every new tet (a, b, c, p) of `faces` (`corners` gives None for a face to skip): calls
+    /// `f` with the corners of those the screen does not clear, in order, until `f` returns
+    /// false. The screen runs over batches laid out by coordinate, so that it vectorizes.
+    pub fn for_each_uncleared<F>(
+        &self,
+        faces: &[F],
+        corners: impl Fn(&F) -> Option<[DVec3; 3]>,
+        p: DVec3,
+        mut f: impl FnMut([DVec3; 3]) -> bool,
+    ) {
+        const BATCH: usize = 8;
+        for batch in faces.chunks(BATCH) {
+            // Skipped lanes and those beyond the batch stay zero (flat: never cleared).
+            let mut q = [[0.0f64; BATCH]; 9];
+            let mut tri = [None; BATCH];
+            for (k, face) in batch.iter().enumerate() {
+                let Some(c) = corners(face) else {
+                    continue;
+                };
+                tri[k] = Some(c);
+                for (j, &x) in c.iter().enumerate() {
+                    let d = x - p;
+                    q[3 * j][k] = d.x;
+                    q[3 * j + 1][k] = d.y;
+                    q[3 * j + 2][k] = d.z;
+                }
+            }
+            let clear = self.clears_batch(&q);
+            for (t, clear) in tri.into_iter().zip(clear) {
+                if let Some(c) = t.filter(|_| !clear) {
+                    if !f(c) {
+                        return;
+                    }
+                }
+            }
+        }
+    }
+
     /// The screen for a batch of tets (p, x_k, y_k, z_k) given by the coordinates relative to
     /// p: `q[0..3]` = x - p, `q[3..6]` = y - p, `q[6..9]` = z - p (lane k: tet k). Branch-free
     /// over the lanes, so that it vectorizes.

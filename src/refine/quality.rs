@@ -9,7 +9,7 @@
 use super::domain::{seg_key, tri_key, Domain, VertexKind};
 use super::mark::Regions;
 use super::{MeshError, Params, Spacing};
-use crate::delaunay::{tables::FACE, Probe, INFINITE};
+use crate::delaunay::{tables::FACE, BoundaryFace, Probe, INFINITE};
 use crate::geom::screen::{
     longest_edge_direct as longest_edge, shortest_edge_sq, sliver_measures, SliverScreen,
 };
@@ -520,39 +520,26 @@ impl<'a> Refiner<'a> {
         let max_r = self.params.b * r;
         let faces = self.dom.dt.probed_cavity().1;
         let points = self.dom.dt.points();
-        // The sliver screen first (most new tets pass it), over batches of faces laid out by
-        // coordinate so that it vectorizes; then the full measures for the others.
-        const BATCH: usize = 8;
-        for batch in faces.chunks(BATCH) {
-            // Lanes of hull faces and beyond the batch stay zero (flat: never cleared).
-            let mut q = [[0.0f64; BATCH]; 9];
-            let mut finite = [false; BATCH];
-            for (k, f) in batch.iter().enumerate() {
-                let v = f.vertices();
-                if v.contains(&INFINITE) {
-                    continue;
-                }
-                finite[k] = true;
-                for (j, &vj) in v.iter().enumerate() {
-                    let d = points[vj as usize] - p;
-                    q[3 * j][k] = d.x;
-                    q[3 * j + 1][k] = d.y;
-                    q[3 * j + 2][k] = d.z;
-                }
-            }
-            let clear = self.screen.clears_batch(&q);
-            for (k, f) in batch.iter().enumerate() {
-                if finite[k] && !clear[k] {
-                    let [x, y, z] = f.vertices().map(|v| points[v as usize]);
-                    if let Some(w) = self.small_sliver(x, y, z, p, max_r) {
-                        n += 1;
-                        if limit.is_some_and(|m| n > m) {
-                            return None;
-                        }
-                        worst = worst.min(w);
+        let corners = |f: &BoundaryFace| {
+            let v = f.vertices();
+            (!v.contains(&INFINITE)).then(|| v.map(|v| points[v as usize]))
+        };
+        let mut over = false;
+        // The sliver screen first (most new tets pass it), then the full measures.
+        self.screen
+            .for_each_uncleared(faces, corners, p, |[x, y, z]| {
+                if let Some(w) = self.small_sliver(x, y, z, p, max_r) {
+                    n += 1;
+                    if limit.is_some_and(|m| n > m) {
+                        over = true;
+                        return false;
                     }
+                    worst = worst.min(w);
                 }
-            }
+                true
+            });
+        if over {
+            return None;
         }
         Some((n, worst))
     }

@@ -13,7 +13,7 @@
 
 use super::{key3, Bad, Loc, Restricted, SurfaceMesher};
 use crate::delaunay::tables::FACE;
-use crate::delaunay::{Inserted, Probe, INFINITE};
+use crate::delaunay::{BoundaryFace, Inserted, Probe, INFINITE};
 use crate::geom::circumsphere;
 use crate::geom::screen::{shortest_edge_sq, sliver_measures, SliverScreen};
 use crate::refine::{random_in_unit_ball, AutoSpacing, Spacing};
@@ -375,29 +375,25 @@ impl SurfaceMesher<'_> {
             return (0, -1.0);
         };
         let (_, faces) = self.dt.probed_cavity();
+        let points = self.dt.points();
+        let corners = |f: &BoundaryFace| {
+            let v = f.vertices();
+            (!v.contains(&INFINITE)).then(|| v.map(|v| points[v as usize]))
+        };
         let mut n = 0;
         let mut worst = -1.0f64;
-        for f in faces {
-            let v = f.vertices();
-            if v.contains(&INFINITE) {
-                continue;
-            }
-            let [x, y, z] = v.map(|k| self.dt.point(k));
-            if vol.screen.clearly_not_sliver(x, y, z, p) {
-                continue;
-            }
-            let l2 = shortest_edge_sq(x, y, z, p);
-            let (sigma, max_cos) = sliver_measures(x, y, z, p, l2);
-            if (sigma < vol.crit.sigma0 || max_cos > vol.cos_min_dihedral)
-                && circumsphere(x, y, z, p).is_none_or(|s| s.1 <= max_r)
-            {
-                n += 1;
-                worst = worst.max(max_cos);
-                if n > enough {
-                    break;
+        vol.screen
+            .for_each_uncleared(faces, corners, p, |[x, y, z]| {
+                let l2 = shortest_edge_sq(x, y, z, p);
+                let (sigma, max_cos) = sliver_measures(x, y, z, p, l2);
+                if (sigma < vol.crit.sigma0 || max_cos > vol.cos_min_dihedral)
+                    && circumsphere(x, y, z, p).is_none_or(|s| s.1 <= max_r)
+                {
+                    n += 1;
+                    worst = worst.max(max_cos);
                 }
-            }
-        }
+                n <= enough
+            });
         (n, worst)
     }
 }
