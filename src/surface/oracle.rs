@@ -159,6 +159,7 @@ impl<'a> SurfaceOracle<'a> {
     /// Splits node `k` at the median centroid along its longest axis, recursively.
     fn split(&mut self, k: usize, centroids: &[DVec3]) {
         let mut work = vec![k];
+        let mut keyed: Vec<(f64, u32)> = Vec::with_capacity(self.order.len());
         while let Some(k) = work.pop() {
             let node = self.nodes[k];
             let (first, count) = (node.first as usize, node.count as usize);
@@ -174,9 +175,17 @@ impl<'a> SurfaceOracle<'a> {
                 2
             };
             let half = count / 2;
-            let key = |t: &u32| (centroids[*t as usize][axis], *t);
-            self.order[first..first + count]
-                .select_nth_unstable_by(half, |a, b| key(a).partial_cmp(&key(b)).unwrap());
+            // The keys side by side: the selection then reads no centroid through an index.
+            keyed.clear();
+            keyed.extend(
+                self.order[first..first + count]
+                    .iter()
+                    .map(|&t| (centroids[t as usize][axis], t)),
+            );
+            keyed.select_nth_unstable_by(half, |a, b| a.partial_cmp(b).unwrap());
+            for (o, k) in self.order[first..first + count].iter_mut().zip(&keyed) {
+                *o = k.1;
+            }
             let left = self.nodes.len();
             let (l, r) = (
                 self.leaf(first, half),
