@@ -82,15 +82,8 @@ struct Rows {
 }
 
 impl Rows {
-    fn of([a, b, c]: [DVec3; 3], step: f64) -> Rows {
-        let (ab, bc, ca) = ((b - a).length(), (c - b).length(), (a - c).length());
-        let corners = if ab >= bc && ab >= ca {
-            [a, b, c]
-        } else if bc >= ca {
-            [b, c, a]
-        } else {
-            [c, a, b]
-        };
+    fn of(corners: [DVec3; 3], step: f64) -> Rows {
+        let corners = super::longest_edge_first(corners);
         let [a, b, c] = corners;
         let height = (b - a).cross(c - a).length() / (b - a).length().max(f64::MIN_POSITIVE);
         Rows {

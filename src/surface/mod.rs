@@ -100,3 +100,16 @@ impl InputSurface {
         }
     }
 }
+
+/// The corners of a triangle turned (cyclically, keeping its orientation) so that the first
+/// edge is the longest.
+pub(crate) fn longest_edge_first([a, b, c]: [DVec3; 3]) -> [DVec3; 3] {
+    let (ab, bc, ca) = ((b - a).length(), (c - b).length(), (a - c).length());
+    if ab >= bc && ab >= ca {
+        [a, b, c]
+    } else if bc >= ca {
+        [b, c, a]
+    } else {
+        [c, a, b]
+    }
+}

@@ -623,7 +623,7 @@ fn cut_into_pieces(surface: &InputSurface, len: f64) -> Vec<Piece> {
     let mut pieces = Vec::with_capacity(surface.triangles.len());
     let mut polygon = Vec::with_capacity(8);
     for t in 0..surface.triangles.len() {
-        let [a, b, c] = longest_edge_first(surface.corners(t));
+        let [a, b, c] = super::longest_edge_first(surface.corners(t));
         let long = (b - a).length();
         let height = (b - a).cross(c - a).length() / long.max(f64::MIN_POSITIVE);
         let count = |step: f64| {
@@ -676,18 +676,6 @@ fn cut_into_pieces(surface: &InputSurface, len: f64) -> Vec<Piece> {
         }
     }
     pieces
-}
-
-/// The corners turned so that the first edge is the longest.
-fn longest_edge_first([a, b, c]: [DVec3; 3]) -> [DVec3; 3] {
-    let (ab, bc, ca) = ((b - a).length(), (c - b).length(), (a - c).length());
-    if ab >= bc && ab >= ca {
-        [a, b, c]
-    } else if bc >= ca {
-        [b, c, a]
-    } else {
-        [c, a, b]
-    }
 }
 
 /// Keeps the part of convex `polygon` where `side` is not negative (Sutherland-Hodgman).
