@@ -42,8 +42,8 @@ fn one_sided(from: &InputSurface, oracle: &SurfaceOracle) -> f64 {
 /// Points per input feature edge where its distance to the output's feature edges is taken.
 const FEATURE_EDGE_SAMPLES: usize = 8;
 
-/// The surface figures of `mesh`; `input` is the oracle of `r.surface` (the caller has one).
-pub fn surface_report(r: &Remeshed, input: &SurfaceOracle, mesh: &TetMesh) -> SurfaceReport {
+/// The surface figures of `mesh`.
+pub fn surface_report(r: &Remeshed, mesh: &TetMesh) -> SurfaceReport {
     // The output boundary: the remeshed triangles where the improvement left their vertices.
     let out = output_surface(mesh);
     let out_volume: f64 = mesh
@@ -57,7 +57,7 @@ pub fn surface_report(r: &Remeshed, input: &SurfaceOracle, mesh: &TetMesh) -> Su
     SurfaceReport {
         surface_distance: r.distance,
         hausdorff_input_to_output: one_sided(&r.surface, &SurfaceOracle::new(&out)),
-        hausdorff_output_to_input: one_sided(&out, input),
+        hausdorff_output_to_input: one_sided(&out, &r.oracle),
         feature_distance: feature_distance(r, &mesh.vertices),
         relative_volume_difference: if r.input_volume > 0.0 {
             (out_volume - r.input_volume) / r.input_volume

@@ -55,6 +55,8 @@ const FACET_MIN_ANGLE_DEG: f64 = 30.0;
 /// the new boundary as a PLC.
 pub struct Remeshed {
     pub surface: InputSurface,
+    /// The oracle of `surface`.
+    pub oracle: SurfaceOracle,
     pub features: Features,
     pub boundary: PlcInput,
     /// Feature edges of the new boundary (vertex pairs of `boundary.vertices`).
@@ -85,16 +87,16 @@ pub fn mesh(
 ) -> Result<(TetMesh, Report), MeshError> {
     let start = std::time::Instant::now();
     let (remeshed, mesh, mut report) = mesh_restricted(input, params, spacing, progress)?;
-    let oracle = SurfaceOracle::new(&remeshed.surface);
+    let oracle = &remeshed.oracle;
     let slide = SurfaceSlide {
-        oracle: &oracle,
+        oracle,
         patch_of: &remeshed.features.patch_of,
         curves: &remeshed.curves,
         vertex_slide: &remeshed.vertex_slide,
         distance: DISTANCE_SAFETY * remeshed.distance,
     };
     let mesh = crate::improve::finish(mesh, &mut report, None, params, Some(&slide))?;
-    let mut surface_report = measure::surface_report(&remeshed, &oracle, &mesh);
+    let mut surface_report = measure::surface_report(&remeshed, &mesh);
     if report.stop_reason.is_none() {
         report.stop_reason = remeshed.stop_reason.clone();
     }
@@ -121,7 +123,7 @@ pub enum Slide {
 /// those on a feature curve along the curve; a boundary triangle must keep its centroid and
 /// edge midpoints within the surface mesher's own distance criterion (half the bound).
 struct SurfaceSlide<'a> {
-    oracle: &'a SurfaceOracle<'a>,
+    oracle: &'a SurfaceOracle,
     patch_of: &'a [u32],
     curves: &'a FeatureCurves,
     vertex_slide: &'a [Slide],
@@ -344,6 +346,7 @@ pub fn remesh(
         curves,
         small_corners,
         surface,
+        oracle,
         features,
         boundary,
         feature_edges: b.feature_edges,

@@ -142,7 +142,7 @@ pub struct Boundary {
 
 pub struct SurfaceMesher<'a> {
     surface: &'a InputSurface,
-    oracle: &'a SurfaceOracle<'a>,
+    oracle: &'a SurfaceOracle,
     curves: &'a FeatureCurves,
     patch_of: &'a [u32],
     spacing: &'a dyn Spacing,
@@ -199,7 +199,7 @@ impl<'a> SurfaceMesher<'a> {
     /// Samples the corners, curves and patches and triangulates the samples.
     pub fn new(
         surface: &'a InputSurface,
-        oracle: &'a SurfaceOracle<'a>,
+        oracle: &'a SurfaceOracle,
         curves: &'a FeatureCurves,
         patch_of: &'a [u32],
         spacing: &'a dyn Spacing,

@@ -74,9 +74,7 @@ pub enum Side {
 }
 
 /// An AABB tree over the triangles of an [`InputSurface`].
-pub struct SurfaceOracle<'a> {
-    /// The oracle copies what it needs (corners, adjacency) but answers for this surface.
-    surface: std::marker::PhantomData<&'a InputSurface>,
+pub struct SurfaceOracle {
     nodes: Vec<Node>,
     pieces: Vec<Piece>,
     /// Piece ids in leaf order.
@@ -96,14 +94,14 @@ pub struct SurfaceOracle<'a> {
     diagonal: f64,
 }
 
-impl<'a> SurfaceOracle<'a> {
-    pub fn new(surface: &'a InputSurface) -> SurfaceOracle<'a> {
+impl SurfaceOracle {
+    /// The oracle of `surface` (it keeps copies of what it needs: the surface may go).
+    pub fn new(surface: &InputSurface) -> SurfaceOracle {
         let n = surface.triangles.len();
         let diagonal = surface.bbox_diagonal();
         let pieces = cut_into_pieces(surface, PIECE_FRACTION * diagonal);
         let corners: Vec<[DVec3; 3]> = (0..n).map(|t| surface.corners(t)).collect();
         let mut o = SurfaceOracle {
-            surface: std::marker::PhantomData,
             nodes: Vec::with_capacity(2 * pieces.len() / LEAF_SIZE + 1),
             order: (0..pieces.len() as u32).collect(),
             leaf_tri: vec![],
