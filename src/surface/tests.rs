@@ -157,27 +157,41 @@ fn features_of_every_shared_surface_are_consistent() {
 
 #[test]
 fn closest_point_matches_brute_force() {
-    let s = model_surface("off/fandisk.off");
-    let o = SurfaceOracle::new(&s);
-    let mut rng = ChaCha8Rng::seed_from_u64(7);
-    let d = s.bbox_diagonal();
-    for _ in 0..300 {
-        let p = DVec3::new(rng.gen(), rng.gen(), rng.gen()) * 2.0 * d - DVec3::splat(d / 2.0);
-        let fast = o.closest(p).unwrap();
-        let brute = (0..s.triangles.len())
-            .map(|t| {
-                let [a, b, c] = s.corners(t);
-                (closest_on_triangle(p, a, b, c) - p).length()
-            })
-            .fold(f64::INFINITY, f64::min);
-        assert!((fast.distance - brute).abs() <= 1e-12 * d, "{p}");
-        // Within a radius just above and just below the distance.
-        assert_eq!(o.distance_beyond(p, fast.distance * 1.001), None, "{p}");
-        assert_eq!(
-            o.distance_beyond(p, fast.distance * 0.999),
-            Some(fast.distance),
-            "{p}"
-        );
+    // joint's long CAD strips are cut into many pieces: the tree over them must still find the
+    // nearest triangle, near the surface as well as far from it.
+    for name in ["off/fandisk.off", "off/joint.off"] {
+        let s = model_surface(name);
+        let o = SurfaceOracle::new(&s);
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let d = s.bbox_diagonal();
+        for k in 0..400 {
+            let p = if k % 2 == 0 {
+                DVec3::new(rng.gen(), rng.gen(), rng.gen()) * 2.0 * d - DVec3::splat(d / 2.0)
+            } else {
+                let [a, b, c] = s.corners(rng.gen_range(0..s.triangles.len()));
+                let (mut u, mut v) = (rng.gen::<f64>(), rng.gen::<f64>());
+                if u + v > 1.0 {
+                    (u, v) = (1.0 - u, 1.0 - v);
+                }
+                let off = DVec3::new(rng.gen(), rng.gen(), rng.gen()) - DVec3::splat(0.5);
+                a + (b - a) * u + (c - a) * v + off * (0.01 * d)
+            };
+            let fast = o.closest(p).unwrap();
+            let brute = (0..s.triangles.len())
+                .map(|t| {
+                    let [a, b, c] = s.corners(t);
+                    (closest_on_triangle(p, a, b, c) - p).length()
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert!((fast.distance - brute).abs() <= 1e-12 * d, "{name} {p}");
+            // Within a radius just above and just below the distance.
+            assert_eq!(o.distance_beyond(p, fast.distance * 1.001), None, "{p}");
+            assert_eq!(
+                o.distance_beyond(p, fast.distance * 0.999),
+                Some(fast.distance),
+                "{name} {p}"
+            );
+        }
     }
 }
 
