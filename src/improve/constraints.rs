@@ -12,6 +12,7 @@
 
 use super::topo::{Work, DEAD};
 use crate::plc::PlcInput;
+use crate::union_find::UnionFind;
 use glam::DVec3;
 use rustc_hash::FxHashMap;
 
@@ -227,14 +228,7 @@ pub(crate) fn classify(w: &mut Work, input: Option<&PlcInput>) -> (Vec<Constrain
         }
     }
     edges.sort_unstable();
-    let mut parent: Vec<u32> = (0..nb as u32).collect();
-    fn find(p: &mut [u32], mut x: u32) -> u32 {
-        while p[x as usize] != x {
-            p[x as usize] = p[p[x as usize] as usize];
-            x = p[x as usize];
-        }
-        x
-    }
+    let mut patches = UnionFind::new(nb);
     let mut i = 0;
     while i < edges.len() {
         let mut j = i;
@@ -248,10 +242,7 @@ pub(crate) fn classify(w: &mut Work, input: Option<&PlcInput>) -> (Vec<Constrain
             let (u, v) = ((key >> 32) as u32, key as u32);
             let flat = coplanar(w, t1, t2);
             if w.bmarker[t1 as usize] == w.bmarker[t2 as usize] && !seg_edge(u, v) && flat {
-                let (r1, r2) = (find(&mut parent, t1), find(&mut parent, t2));
-                if r1 != r2 {
-                    parent[r1.max(r2) as usize] = r1.min(r2);
-                }
+                patches.union(t1, t2);
                 merged = true;
             }
         }
@@ -264,7 +255,7 @@ pub(crate) fn classify(w: &mut Work, input: Option<&PlcInput>) -> (Vec<Constrain
     let mut id = vec![DEAD; nb];
     let mut normals: Vec<DVec3> = vec![];
     for t in 0..nb {
-        let r = find(&mut parent, t as u32) as usize;
+        let r = patches.find(t as u32) as usize;
         if id[r] == DEAD {
             id[r] = normals.len() as u32;
             normals.push(DVec3::ZERO);
