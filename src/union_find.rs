@@ -1,6 +1,7 @@
 //! Disjoint sets over `0..n` (path halving; the smaller id is always the root, so a set's root
 //! is its smallest member and results do not depend on the order of unions). The crate's one
-//! union-find: plc (cells, coplanar merging) and refine (domain marking, existing meshes).
+//! union-find: plc (cells, coplanar merging), refine (domain marking, existing meshes) and
+//! improve (boundary patches).
 
 #[derive(Debug, Clone)]
 pub(crate) struct UnionFind(Vec<u32>);
