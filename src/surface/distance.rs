@@ -1,7 +1,8 @@
 //! Two-sided Hausdorff distance between triangle surfaces, by dense sampling: every triangle
-//! is sampled finely enough that no point of it is farther than `spacing` from a sample, and each sample's distance to the other surface is exact up to rounding
-//! (closest point through the AABB tree). The result therefore underestimates the true
-//! distance by at most `spacing`.
+//! is sampled finely enough that no point of it is farther than `spacing` from a sample, and
+//! each sample's distance to the other surface is exact up to rounding (closest point through
+//! the AABB tree). The result therefore underestimates the true distance by at most
+//! `spacing`.
 
 use super::oracle::SurfaceOracle;
 use super::InputSurface;

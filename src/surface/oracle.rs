@@ -616,7 +616,8 @@ impl Occupancy {
 
 /// Every triangle cut into pieces `len` to 2 `len` across (at most [`MAX_PIECES`] each), as
 /// boxes: strips parallel to its longest edge, each cut across along that edge (a triangle
-/// under 2 `len` stays whole: smaller pieces only make the tree deeper). The boxes only need to cover the triangle: they are padded like the nodes.
+/// under 2 `len` stays whole: smaller pieces only make the tree deeper). The boxes only need
+/// to cover the triangle: they are padded like the nodes.
 fn cut_into_pieces(surface: &InputSurface, len: f64) -> Vec<Piece> {
     let mut pieces = Vec::with_capacity(surface.triangles.len());
     let mut polygon = Vec::with_capacity(8);
