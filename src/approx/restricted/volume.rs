@@ -168,7 +168,11 @@ impl SurfaceMesher<'_> {
         if tv.contains(&INFINITE) || tv.iter().any(|&v| self.loc[v as usize] == Loc::Far) {
             return None;
         }
-        if tv.iter().any(|&v| vol.near_small[v as usize]) {
+        let near_small = |v: u32| match vol.near_small.get(v as usize) {
+            Some(&near) => near,
+            None => self.near_small_corner(self.dt.point(v)),
+        };
+        if tv.iter().any(|&v| near_small(v)) {
             return None;
         }
         let [a, b, c, d] = tv.map(|v| self.dt.point(v));
