@@ -103,8 +103,8 @@ impl AutoSpacing {
         (k * self.dims[1] + j) * self.dims[0] + i
     }
 
-    /// Two chamfer sweeps (forward, backward) over the 26-neighbourhood enforce
-    /// f(x) <= f(y) + ALPHA |x - y| between neighbouring cells.
+    /// Flags every cell that has small sizes in it or in one of its 26 neighbours (`at` looks
+    /// at those lists only there).
     fn mark_small_nearby(&mut self) {
         let [nx, ny, nz] = self.dims;
         for k in 0..nz {
@@ -125,6 +125,8 @@ impl AutoSpacing {
         }
     }
 
+    /// Two chamfer sweeps (forward, backward) over the 26-neighbourhood enforce
+    /// f(x) <= f(y) + ALPHA |x - y| between neighbouring cells.
     fn propagate(&mut self) {
         let [nx, ny, nz] = self.dims;
         let idx = |i: usize, j: usize, k: usize| (k * ny + j) * nx + i;
