@@ -110,8 +110,11 @@ fn deterministic() {
     assert_eq!(a, b);
 }
 
-/// The acute models: no degenerate tet, the surface kept, and the improvement helps.
-fn acute(rel: &str) {
+/// The acute models: no degenerate tet, the surface kept, the improvement helps, and the
+/// smallest dihedral angle is at least `floor_deg` (a little below what tetgen -pq1.414
+/// reaches at a similar tet count; before the improver's vertex insertion and the refinement
+/// stopped splitting around flat tets, rotor, spool and anchor ended at 0.00 degrees).
+fn acute(rel: &str, floor_deg: f64) {
     let (m, r) = mesh(rel, true);
     check_kept(rel, &m);
     let (lo, _) = dihedral_range(&m);
@@ -119,31 +122,31 @@ fn acute(rel: &str) {
         lo >= r.dihedral_before_improve_deg[0],
         "{rel}: {lo} < before"
     );
-    assert!(lo > 0.0);
+    assert!(lo >= floor_deg, "{rel}: min dihedral {lo} < {floor_deg}");
 }
 
 #[test]
 fn acute_rotor() {
-    acute("off/rotor.off");
+    acute("off/rotor.off", 1.0);
 }
 #[test]
 fn acute_part() {
-    acute("off/part.off");
+    acute("off/part.off", 3.0);
 }
 #[test]
 fn acute_fandisk_joint() {
-    acute("off/fandisk.off");
-    acute("off/joint.off");
+    acute("off/fandisk.off", 12.0);
+    acute("off/joint.off", 6.0);
 }
 #[test]
 fn acute_others() {
-    for rel in [
-        "off/anchor.off",
-        "off/elephant.off",
-        "off/oblong.off",
-        "off/spool.off",
-        "off/star.off",
+    for (rel, floor_deg) in [
+        ("off/anchor.off", 0.3),
+        ("off/elephant.off", 3.0),
+        ("off/oblong.off", 12.0),
+        ("off/spool.off", 2.5),
+        ("off/star.off", 30.0),
     ] {
-        acute(rel);
+        acute(rel, floor_deg);
     }
 }

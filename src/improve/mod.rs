@@ -9,17 +9,20 @@
 //!   segment, facet vertices in the facet's plane), and the flat facet patches;
 //! - `flips`: edge removal (3-2, 4-4 and larger rings by dynamic programming), the boundary 2-2
 //!   flip inside one facet patch, face removal (2-3);
-//! - `smooth`: non-smooth optimisation of the worst objective of a vertex's star.
+//! - `smooth`: non-smooth optimisation of the worst objective of a vertex's star;
+//! - `insert`: a new vertex joined to the outer faces of a cavity around the tet, placed by
+//!   the same optimisation.
 //!
 //! The driver takes the tets whose objective is below the target, worst first, and tries the
-//! best topological change touching the tet, then smoothing of its vertices. Every accepted
-//! change keeps every tet it makes positively oriented (exact `orient3d`) and strictly raises
-//! the worst objective of the tets it replaces or moves. Passes repeat until one changes
+//! best topological change touching the tet, then smoothing of its vertices, then insertion.
+//! Every accepted change keeps every tet it makes positively oriented (exact `orient3d`) and
+//! strictly raises the worst objective of the tets it replaces or moves. Passes repeat until one changes
 //! nothing or the budget is spent. Order: by objective, then tet slot; no hashing decides
 //! anything, so the result is deterministic.
 
 mod constraints;
 mod flips;
+mod insert;
 pub mod quality;
 mod smooth;
 mod topo;
@@ -67,6 +70,8 @@ pub struct Stats {
     pub face_removals: usize,
     pub boundary_flips: usize,
     pub smoothed: usize,
+    /// Vertices inserted where flips and smoothing left a tet bad.
+    pub insertions: usize,
     /// Vertices smoothing was tried on (`smoothed` of them moved).
     pub smooth_attempts: usize,
     pub passes: usize,
@@ -247,6 +252,19 @@ impl Improver<'_> {
                                 }
                             }
                             break;
+                        }
+                    }
+                }
+                if touched.is_empty() && !capped {
+                    if let Some(plan) = self.plan_insertion(t) {
+                        touched = self.apply_insertion(plan);
+                        stamp.resize(self.w.pos.len(), 0);
+                        smoothings.resize(self.w.pos.len(), 0);
+                        clock += 1;
+                        for &n in &touched {
+                            for u in self.w.tets[n as usize] {
+                                stamp[u as usize] = clock;
+                            }
                         }
                     }
                 }

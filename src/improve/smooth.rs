@@ -60,40 +60,33 @@ fn min_norm(g: &[DVec3]) -> DVec3 {
 
 impl Improver<'_> {
     /// Worst objective of v's star with v at x.
-    fn star_min(&self, star: &[[u32; 4]], v: u32, x: DVec3) -> f64 {
+    pub(crate) fn star_min(&self, star: &[[u32; 4]], v: u32, x: DVec3) -> f64 {
         star.iter()
             .map(|t| q_at(&self.w.pos, self.w.rho_weight, t, v, x))
             .fold(f64::INFINITY, f64::min)
     }
 
-    /// Moves vertex v to raise the worst objective of its star; true when it moved.
-    pub(crate) fn smooth(&mut self, v: u32) -> bool {
-        let cons = self.cons[v as usize];
-        if cons == Constraint::Fixed {
-            return false;
-        }
-        let ids = self.w.star[v as usize].clone();
-        if ids.is_empty() {
-            return false;
-        }
-        if cons == Constraint::Free && on_hull(&self.w, v, &mut Vec::new()) {
-            // A hull face missing from the boundary list: the vertex is on the boundary.
-            self.cons[v as usize] = Constraint::Fixed;
-            return false;
-        }
-        let star: Vec<[u32; 4]> = ids.iter().map(|&t| self.w.tets[t as usize]).collect();
-        let x0 = self.w.p(v);
-        let q0 = ids
-            .iter()
-            .map(|&t| self.w.q[t as usize])
-            .fold(f64::INFINITY, f64::min);
+    /// The non-smooth ascent of the worst objective of `star` (tets holding vertex `v`, which
+    /// starts at `x0` with worst objective `q0`) within constraint `cons`: the position
+    /// reached and its worst objective. Only the positions of the other vertices are read,
+    /// so `v` may be a vertex not yet in the mesh.
+    pub(crate) fn ascend(
+        &self,
+        star: &[[u32; 4]],
+        v: u32,
+        x0: DVec3,
+        q0: f64,
+        cons: Constraint,
+    ) -> (DVec3, f64) {
         // Length scale: the mean edge length at v.
         let mut scale = 0.0;
         let mut count = 0.0;
-        for t in &star {
+        let mut centroid = DVec3::ZERO;
+        for t in star {
             for &u in t {
                 if u != v {
                     scale += self.w.p(u).distance(x0);
+                    centroid += self.w.p(u);
                     count += 1.0;
                 }
             }
@@ -103,19 +96,8 @@ impl Improver<'_> {
         let mut qx = q0;
 
         // A first guess: the centroid of the neighbours (within the constraint).
-        let centroid = {
-            let mut c = DVec3::ZERO;
-            for t in &star {
-                for &u in t {
-                    if u != v {
-                        c += self.w.p(u);
-                    }
-                }
-            }
-            c / count
-        };
-        let guess = x0 + cons.project(centroid - x0);
-        let qg = self.star_min(&star, v, guess);
+        let guess = x0 + cons.project(centroid / count - x0);
+        let qg = self.star_min(star, v, guess);
         if qg > qx + MIN_GAIN {
             x = guess;
             qx = qg;
@@ -151,7 +133,7 @@ impl Improver<'_> {
             let mut moved = false;
             for _ in 0..10 {
                 let y = x + dir * step;
-                let qy = self.star_min(&star, v, y);
+                let qy = self.star_min(star, v, y);
                 if qy > qx + MIN_GAIN {
                     x = y;
                     qx = qy;
@@ -164,6 +146,31 @@ impl Improver<'_> {
                 break;
             }
         }
+        (x, qx)
+    }
+
+    /// Moves vertex v to raise the worst objective of its star; true when it moved.
+    pub(crate) fn smooth(&mut self, v: u32) -> bool {
+        let cons = self.cons[v as usize];
+        if cons == Constraint::Fixed {
+            return false;
+        }
+        let ids = self.w.star[v as usize].clone();
+        if ids.is_empty() {
+            return false;
+        }
+        if cons == Constraint::Free && on_hull(&self.w, v, &mut Vec::new()) {
+            // A hull face missing from the boundary list: the vertex is on the boundary.
+            self.cons[v as usize] = Constraint::Fixed;
+            return false;
+        }
+        let star: Vec<[u32; 4]> = ids.iter().map(|&t| self.w.tets[t as usize]).collect();
+        let x0 = self.w.p(v);
+        let q0 = ids
+            .iter()
+            .map(|&t| self.w.q[t as usize])
+            .fold(f64::INFINITY, f64::min);
+        let (mut x, mut qx) = self.ascend(&star, v, x0, q0, cons);
         if let Some(s) = self.sliding(v) {
             // Back onto the input surface, where the move is judged.
             let Some(y) = s.project(v, x) else {

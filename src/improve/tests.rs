@@ -325,3 +325,56 @@ fn two_three_flip() {
     let plan = im.plan_face([0, 1, 2]).expect("2-3 flip improves");
     assert!(plan.new_min > im.w.q[0].max(im.w.q[1]));
 }
+
+/// A flat tet on a slightly folded base, under a pyramid whose every vertex is on the hull
+/// (so fixed): a vertex inserted above the base lifts it (the insertion planned directly: on
+/// this small cavity the 3-2 flip would also do).
+#[test]
+fn insertion_lifts_a_flat_tet_off_a_fold() {
+    let vertices = vec![
+        DVec3::new(0.0, 0.0, 0.0),
+        DVec3::new(1.0, 0.0, 0.0),
+        DVec3::new(0.0, 1.0, 0.0),
+        DVec3::new(1.0, 1.0, 1e-3),
+        DVec3::new(0.5, 0.5, 0.8),
+    ];
+    // The flat tet (lower faces abc, bcd on the hull) and the two tets above its upper faces
+    // abd, acd.
+    let mut tets = vec![[0, 1, 2, 3], [0, 1, 3, 4], [0, 2, 3, 4]];
+    for t in &mut tets {
+        let p = t.map(|v| vertices[v as usize]);
+        if orient3d(p[0], p[1], p[2], p[3]) < 0.0 {
+            t.swap(2, 3);
+        }
+    }
+    let mesh = TetMesh {
+        vertices,
+        tets,
+        tet_regions: vec![1; 3],
+        ..Default::default()
+    };
+    let before = min_q(&mesh);
+    assert!(before < 1e-2);
+    let mut w = topo::Work::new(&mesh, f64::INFINITY);
+    let (cons, normals) = constraints::classify(&mut w, None);
+    let mut im = Improver {
+        w,
+        cons,
+        normals,
+        slide: None,
+        stats: Stats::default(),
+    };
+    let plan = im.plan_insertion(0).expect("an insertion");
+    let made = im.apply_insertion(plan);
+    assert_eq!((made.len(), im.stats.insertions), (6, 1));
+    let out = im.w.to_mesh();
+    assert_eq!(out.vertices.len(), 6);
+    assert!(
+        out.vertices[..5] == mesh.vertices[..],
+        "a hull vertex moved"
+    );
+    assert!(min_q(&out) > 0.15, "{} -> {}", before, min_q(&out));
+    assert!((vol(&out) - vol(&mesh)).abs() <= 1e-12 * vol(&mesh));
+    assert!(out.tet_regions.iter().all(|&r| r == 1));
+    check_no_degenerate(&out).unwrap();
+}

@@ -143,6 +143,14 @@ impl Work {
         id
     }
 
+    /// Adds a vertex at `x` with an empty star; returns its id.
+    pub fn add_vertex(&mut self, x: DVec3) -> u32 {
+        self.pos.push(x);
+        self.star.push(Vec::new());
+        self.bstar.push(Vec::new());
+        (self.pos.len() - 1) as u32
+    }
+
     pub fn kill_tet(&mut self, id: u32) {
         let t = self.tets[id as usize];
         for v in t {

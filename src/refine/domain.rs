@@ -262,6 +262,40 @@ impl Domain {
         self.near_small_angle[v as usize]
     }
 
+    /// Whether tet `verts` is flat by construction: three of its vertices lie on one input
+    /// segment, or all four in one input facet. Boundary points are rounded, so the exact
+    /// predicates see such a tet with a positive volume, but that volume is rounding noise:
+    /// its centroid and circumcentre lie on the boundary to rounding, and a volume vertex
+    /// there would encroach the boundary at every scale (a cascade of splits converging on
+    /// it, seen on spool.off).
+    pub fn flat_by_construction(&self, verts: [u32; 4]) -> bool {
+        let on_segment = |v: u32, s: u32| match self.kind[v as usize] {
+            VertexKind::Segment(t) => t == s,
+            VertexKind::Input => self.segments[s as usize].ends.contains(&v),
+            _ => false,
+        };
+        let in_facet = |v: u32, f: u32| self.facets[f as usize].point(v).is_some();
+        for &v in &verts {
+            match self.kind[v as usize] {
+                VertexKind::Segment(s) => {
+                    if verts.iter().filter(|&&w| on_segment(w, s)).count() >= 3 {
+                        return true;
+                    }
+                    let facets = &self.segments[s as usize].facets;
+                    if facets
+                        .iter()
+                        .any(|&f| verts.iter().all(|&w| in_facet(w, f)))
+                    {
+                        return true;
+                    }
+                }
+                VertexKind::Facet(f) => return verts.iter().all(|&w| in_facet(w, f)),
+                VertexKind::Input | VertexKind::Volume => {}
+            }
+        }
+        false
+    }
+
     /// The acute input vertex whose protecting ball holds a new boundary point `p` (the
     /// nearest, if several), or `NO_APEX`. Volume points are never protected.
     fn apex_of(&self, p: DVec3, kind: VertexKind) -> u32 {

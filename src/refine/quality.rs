@@ -286,6 +286,14 @@ impl<'a> Refiner<'a> {
     }
 
     fn refine_tet(&mut self, bad: Bad, may_defer: bool) -> Result<(), MeshError> {
+        if self.dom.flat_by_construction(bad.verts) {
+            // No point inside it or at its centre can help (see `flat_by_construction`):
+            // restoring the boundary around it may; else the improvement removes it.
+            if !self.resettle_near(bad.tet)? {
+                self.gave_up += 1;
+            }
+            return Ok(());
+        }
         let near = bad.verts.iter().any(|&v| self.dom.near_acute(v));
         let [a, b, c, d] = self.dom.dt.tet_points(bad.tet);
         if near && bad.class == SIZE {
@@ -990,13 +998,6 @@ mod tests {
         }
     }
 
-    /// The stale-element case of `refine_encroached`: a bad tet's centre encroaches a
-    /// subsegment much smaller than the tet, so the boundary around the tet is restored first
-    /// (`resettle_near`). When that split the very subsegment (here: one left encroached on
-    /// purpose, the invariant a leak in the incremental bookkeeping would break), the element
-    /// found before the change is gone and must not be split again: it used to be, which
-    /// failed with an internal error ("not a subsegment"); a stale subfacet would have been
-    /// split at the centre of a triangle no longer in its facet.
     /// The unit cube meshed to a conforming boundary, then a volume vertex put in the
     /// diametric ball of subsegment (0, 1) without restoring the boundary (the state a leak in
     /// the incremental bookkeeping would leave): the subsegment stays an edge (a hull edge of
@@ -1056,5 +1057,38 @@ mod tests {
             .refine_encroached(bad, Boundary::Segment(0, 1), 20.0 * 0.5)
             .expect("no split of a subsegment that is gone");
         assert_eq!(dom.dt.num_vertices(), expected);
+    }
+
+    /// Tets that are flat by construction (three vertices on one segment, or four in one
+    /// facet, one of them inserted) are named so; one reaching across the cube is not. (Four
+    /// input vertices are exact: the predicates see their flatness.)
+    #[test]
+    fn flat_by_construction_names_collinear_and_coplanar_tets() {
+        let input = cube_input();
+        let mut dom = Domain::new(&input).unwrap();
+        dom.recover_boundary(&mut 1_000_000).unwrap();
+        let s = dom
+            .segments
+            .iter()
+            .position(|s| s.ends.contains(&0) && s.ends.contains(&1))
+            .unwrap();
+        let mid = dom.segment_split_point(0, 1);
+        let m = dom.split_subsegment(0, 1, mid).unwrap();
+        assert_eq!(dom.kind[m as usize], VertexKind::Segment(s as u32));
+        let f = dom.segments[s].facets[0];
+        let in_f: Vec<u32> = dom.facets[f as usize]
+            .vertices()
+            .filter(|&v| v < 8)
+            .collect();
+        assert_eq!(in_f.len(), 4);
+        let off_f = (0..8).find(|v| !in_f.contains(v)).unwrap();
+        assert!(dom.flat_by_construction([0, m, 1, off_f]));
+        assert!(dom.flat_by_construction([m, in_f[1], in_f[2], in_f[3]]));
+        let [a, b, c] = [in_f[0], in_f[1], in_f[2]];
+        assert!(!dom.flat_by_construction([a, b, c, off_f]));
+        let x = dom
+            .insert_point(DVec3::splat(0.5), VertexKind::Volume, None)
+            .unwrap();
+        assert!(!dom.flat_by_construction([0, m, x, off_f]));
     }
 }

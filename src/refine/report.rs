@@ -110,12 +110,13 @@ impl Report {
         row(
             "time improvement (s)",
             format!(
-                "{:.3} (flips {}, moves {}{})",
+                "{:.3} (flips {}, moves {}, insertions {}{})",
                 self.seconds_improvement,
                 self.improvement.edge_removals
                     + self.improvement.face_removals
                     + self.improvement.boundary_flips,
                 self.improvement.smoothed,
+                self.improvement.insertions,
                 if self.delaunay { ", Delaunay" } else { "" }
             ),
         );
