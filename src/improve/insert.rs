@@ -2,10 +2,12 @@
 //! operation): typically a flat tet whose four vertices are fixed on the boundary, lying on
 //! a nearly flat fold of it, where no flip applies and nothing may move.
 //!
-//! A cavity is grown from the bad tet across interior faces (same region, never across a
-//! boundary triangle), one and two layers deep; the new vertex is joined to every outer face
-//! of the cavity, starting at the bad tet's centroid and moved by the smoothing ascent to
-//! maximise the worst new tet (the better of the two cavities is taken).
+//! The cavity starts as the bad tet and its face neighbours (same region, never across a
+//! boundary triangle); the new vertex is joined to every outer face of the cavity, starting
+//! at the bad tet's centroid and moved by the smoothing ascent to maximise the worst new tet.
+//! Then the cavity takes the tet beyond the outer face of the worst new tet (the face that
+//! binds the vertex) and the ascent goes on from where it stopped, a few times; the best
+//! cavity is kept (in the manner of Gmsh/HXT's growing cavities).
 //! The change is applied only when every new tet is positively oriented by the exact
 //! `orient3d` and the worst new tet beats the worst cavity tet. The outer faces are kept, so
 //! (the degree argument of `flips`) the new tets tile the cavity.
@@ -16,8 +18,8 @@ use super::topo::DEAD;
 use super::Improver;
 use glam::DVec3;
 
-/// Layers of face neighbours around the bad tet that a cavity may take.
-const LAYERS: usize = 2;
+/// Growth steps of a cavity (each adds the tet beyond the worst new tet's outer face).
+const MAX_GROWTH: usize = 8;
 /// Most tets in a cavity (keeps the ascent cheap).
 const MAX_CAVITY: usize = 24;
 
@@ -39,55 +41,78 @@ impl Improver<'_> {
     pub(crate) fn plan_insertion(&self, t: u32) -> Option<Insertion> {
         let w = &self.w;
         let region = w.region[t as usize];
-        let x0 = w.points(&w.tets[t as usize]).iter().sum::<DVec3>() * 0.25;
+        let mut x = w.points(&w.tets[t as usize]).iter().sum::<DVec3>() * 0.25;
         let mut cavity = vec![t];
-        let mut best: Option<Insertion> = None;
-        for _ in 0..LAYERS {
-            self.grow(&mut cavity, region);
-            let Some(plan) = self.plan_cavity(&cavity, region, x0) else {
-                continue;
-            };
-            if best.as_ref().is_none_or(|b| plan.new_min > b.new_min) {
-                best = Some(plan);
+        for i in 0..4 {
+            if let Some(nb) = self.beyond(t, i, region) {
+                cavity.push(nb);
             }
+        }
+        let mut best: Option<Insertion> = None;
+        for _ in 0..MAX_GROWTH {
+            let (make, from) = self.cone(&cavity);
+            let old = cavity
+                .iter()
+                .map(|&c| w.q[c as usize])
+                .fold(f64::INFINITY, f64::min);
+            let q0 = self.star_min(&make, NEW, x);
+            let (at, new_min) = self.ascend(&make, NEW, x, q0, Constraint::Free);
+            x = at;
+            if new_min > old + MIN_GAIN
+                && best.as_ref().is_none_or(|b| new_min > b.new_min)
+                && make.iter().all(|t| {
+                    let p = t.map(|v| if v == NEW { at } else { w.p(v) });
+                    crate::geom::orient3d(p[0], p[1], p[2], p[3]) > 0.0
+                })
+            {
+                best = Some(Insertion {
+                    at,
+                    kill: cavity.clone(),
+                    make: make.clone(),
+                    region,
+                    new_min,
+                });
+            }
+            if cavity.len() >= MAX_CAVITY {
+                break;
+            }
+            // Grow across the outer face of the worst new tet that has a tet beyond it.
+            let mut order: Vec<(f64, usize)> = make
+                .iter()
+                .enumerate()
+                .map(|(k, t)| (self.star_min(std::slice::from_ref(t), NEW, at), k))
+                .collect();
+            order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            let Some(nb) = order.iter().find_map(|&(_, k)| {
+                let (c, i) = from[k];
+                self.beyond(c, i, region).filter(|nb| !cavity.contains(nb))
+            }) else {
+                break;
+            };
+            cavity.push(nb);
         }
         best
     }
 
-    /// Adds to `cavity` its face neighbours of region `region` across interior faces, up to
-    /// `MAX_CAVITY` tets. Whether the cavity is star-shaped from some point is left to the
-    /// ascent: it starts wherever the centroid is, inverted new tets included (the signed
-    /// objective rises as they turn over).
-    fn grow(&self, cavity: &mut Vec<u32>, region: i32) {
+    /// The tet of region `region` across face `i` of tet `c`, unless that face is a boundary
+    /// triangle or on the hull.
+    fn beyond(&self, c: u32, i: usize, region: i32) -> Option<u32> {
         let w = &self.w;
-        let layer = cavity.clone();
-        for &c in &layer {
-            let tv = w.tets[c as usize];
-            for i in 0..4 {
-                if cavity.len() >= MAX_CAVITY {
-                    return;
-                }
-                let f = face(tv, i);
-                if w.is_boundary_face(f) {
-                    continue;
-                }
-                let (pair, n) = w.face_tets(f);
-                if n != 2 {
-                    continue;
-                }
-                let nb = if pair[0] == c { pair[1] } else { pair[0] };
-                if cavity.contains(&nb) || w.region[nb as usize] != region {
-                    continue;
-                }
-                cavity.push(nb);
-            }
+        let f = face(w.tets[c as usize], i);
+        if w.is_boundary_face(f) {
+            return None;
         }
+        let (pair, n) = w.face_tets(f);
+        let nb = if pair[0] == c { pair[1] } else { pair[0] };
+        (n == 2 && w.region[nb as usize] == region).then_some(nb)
     }
 
-    /// The new vertex joined to the outer faces of `cavity`, placed by the ascent from `x0`.
-    fn plan_cavity(&self, cavity: &[u32], region: i32, x0: DVec3) -> Option<Insertion> {
+    /// The new tets joining `NEW` to the outer faces of `cavity` (each a cavity tet with the
+    /// vertex opposite that face replaced), with the (cavity tet, face) each comes from.
+    fn cone(&self, cavity: &[u32]) -> (Vec<[u32; 4]>, Vec<(u32, usize)>) {
         let w = &self.w;
         let mut make = vec![];
+        let mut from = vec![];
         for &c in cavity {
             let tv = w.tets[c as usize];
             for i in 0..4 {
@@ -100,29 +125,11 @@ impl Improver<'_> {
                     let mut nt = tv;
                     nt[i] = NEW;
                     make.push(nt);
+                    from.push((c, i));
                 }
             }
         }
-        let old = cavity
-            .iter()
-            .map(|&c| w.q[c as usize])
-            .fold(f64::INFINITY, f64::min);
-        let q0 = self.star_min(&make, NEW, x0);
-        let (at, new_min) = self.ascend(&make, NEW, x0, q0, Constraint::Free);
-        if new_min <= old + MIN_GAIN || new_min.is_nan() {
-            return None;
-        }
-        let ok = make.iter().all(|t| {
-            let p = t.map(|v| if v == NEW { at } else { w.p(v) });
-            crate::geom::orient3d(p[0], p[1], p[2], p[3]) > 0.0
-        });
-        ok.then(|| Insertion {
-            at,
-            kill: cavity.to_vec(),
-            make,
-            region,
-            new_min,
-        })
+        (make, from)
     }
 
     /// Carries an insertion out; returns the new tets.
