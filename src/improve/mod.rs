@@ -118,6 +118,13 @@ pub trait SurfaceSlide {
 /// the determinant to products of edge lengths and face areas: rounding cannot reach it).
 const SURELY_POSITIVE: f64 = 1e-6;
 
+/// The climb (`Improver::climb`): rounds at most, degrees gained per round, the most tets a
+/// round may work on, and the angle it stops at.
+const CLIMB_ROUNDS: usize = 12;
+const CLIMB_STEP_DEG: f64 = 2.0;
+const CLIMB_MAX_TETS: usize = 200;
+const CLIMB_LIMIT_DEG: f64 = 45.0;
+
 /// Smoothings of one vertex per pass at most (each must gain, but gains can be small).
 const MAX_SMOOTHINGS: u8 = 2;
 
@@ -183,117 +190,174 @@ impl Improver<'_> {
 
     fn run(&mut self, opts: &Options) {
         let target = opts.target_deg.to_radians().sin();
-        // Work budget: changes per pass, a multiple of the mesh size.
-        let budget = 4 * self.w.tets.len() + 1000;
-        // Change clock: a vertex's stamp is the last change around it; a tet that nothing
-        // helped is not tried again until one of its vertices is stamped later.
-        let mut clock: u32 = 1;
-        let mut stamp = vec![0u32; self.w.pos.len()];
-        let mut tried = vec![0u32; self.w.tets.len()];
+        let mut st = PassState {
+            // Work budget: changes per pass, a multiple of the mesh size.
+            budget: 4 * self.w.tets.len() + 1000,
+            clock: 1,
+            stamp: vec![0; self.w.pos.len()],
+            tried: vec![0; self.w.tets.len()],
+        };
         for _ in 0..opts.max_passes {
-            self.stats.passes += 1;
-            let mut heap: BinaryHeap<Reverse<(u64, u32, [u32; 4])>> = BinaryHeap::new();
-            for t in 0..self.w.tets.len() as u32 {
-                if self.w.alive[t as usize] && self.bad(t, target, opts.improve) {
-                    heap.push(Reverse((
-                        key(self.w.q[t as usize]),
-                        t,
-                        self.w.tets[t as usize],
-                    )));
-                }
-            }
-            let mut changes = 0;
-            let mut smoothings = vec![0u8; self.w.pos.len()];
-            while let Some(Reverse((_, t, tv))) = heap.pop() {
-                if changes >= budget {
-                    break;
-                }
-                let ti = t as usize;
-                if !self.w.alive[ti] || self.w.tets[ti] != tv || !self.bad(t, target, opts.improve)
-                {
-                    continue;
-                }
-                if tried[ti] != 0 && tv.iter().all(|&v| stamp[v as usize] <= tried[ti]) {
-                    continue;
-                }
-                let mut touched: Vec<u32> = vec![];
-                let mut capped = false;
-                let t0 = std::time::Instant::now();
-                let plan = self.best_plan(t);
-                self.stats.seconds_plans += t0.elapsed().as_secs_f64();
-                if let Some(plan) = plan {
-                    touched = self.apply(plan);
-                    clock += 1;
-                    for &n in &touched {
-                        for v in self.w.tets[n as usize] {
-                            stamp[v as usize] = clock;
-                        }
-                    }
-                    for v in tv {
-                        stamp[v as usize] = clock;
-                    }
-                } else {
-                    for v in tv {
-                        if smoothings[v as usize] >= MAX_SMOOTHINGS {
-                            capped = true;
-                            continue;
-                        }
-                        smoothings[v as usize] += 1;
-                        self.stats.smooth_attempts += 1;
-                        let t0 = std::time::Instant::now();
-                        let ok = self.smooth(v);
-                        self.stats.seconds_smooth += t0.elapsed().as_secs_f64();
-                        if ok {
-                            touched = self.w.star[v as usize].clone();
-                            clock += 1;
-                            for &n in &touched {
-                                for u in self.w.tets[n as usize] {
-                                    stamp[u as usize] = clock;
-                                }
-                            }
-                            break;
-                        }
-                    }
-                }
-                if touched.is_empty() && !capped {
-                    if let Some(plan) = self.plan_insertion(t) {
-                        touched = self.apply_insertion(plan);
-                        stamp.resize(self.w.pos.len(), 0);
-                        smoothings.resize(self.w.pos.len(), 0);
-                        clock += 1;
-                        for &n in &touched {
-                            for u in self.w.tets[n as usize] {
-                                stamp[u as usize] = clock;
-                            }
-                        }
-                    }
-                }
-                if tried.len() < self.w.tets.len() {
-                    tried.resize(self.w.tets.len(), 0);
-                }
-                if touched.is_empty() {
-                    if !capped {
-                        tried[ti] = clock;
-                    }
-                    continue;
-                }
-                changes += 1;
-                for n in touched {
-                    tried[n as usize] = 0;
-                    if self.bad(n, target, opts.improve) {
-                        heap.push(Reverse((
-                            key(self.w.q[n as usize]),
-                            n,
-                            self.w.tets[n as usize],
-                        )));
-                    }
-                }
-            }
-            if changes == 0 {
+            if self.pass(target, opts.improve, &mut st) == 0 {
                 break;
             }
         }
+        if opts.improve {
+            self.climb(target, &mut st);
+        }
     }
+
+    /// Once every tet is above the target: passes over the worst tets with a target a little
+    /// above the worst, as long as few tets are below it (so the cost does not grow with the
+    /// mesh: on a large mesh many tets sit just above the target and this stops at once) and
+    /// the worst keeps rising. Small meshes of simple domains gain the most (tetgen's coarse
+    /// meshes of them are nearly regular).
+    fn climb(&mut self, target: f64, st: &mut PassState) {
+        let limit = CLIMB_LIMIT_DEG.to_radians().sin();
+        let mut worst = self.worst();
+        for _ in 0..CLIMB_ROUNDS {
+            if worst < target || worst >= limit {
+                return;
+            }
+            let next = ((worst.asin().to_degrees() + CLIMB_STEP_DEG)
+                .to_radians()
+                .sin())
+            .min(limit);
+            let below = (0..self.w.tets.len())
+                .filter(|&t| self.w.alive[t] && self.w.q[t] < next)
+                .count();
+            if below > CLIMB_MAX_TETS {
+                return;
+            }
+            self.pass(next, true, st);
+            let now = self.worst();
+            if now <= worst {
+                return;
+            }
+            worst = now;
+        }
+    }
+
+    /// The worst objective of the alive tets.
+    fn worst(&self) -> f64 {
+        (0..self.w.tets.len())
+            .filter(|&t| self.w.alive[t])
+            .map(|t| self.w.q[t])
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// One pass over the tets below `target` (or only the flat and inverted ones when not
+    /// `improve`), worst first; returns the number of changes.
+    fn pass(&mut self, target: f64, improve: bool, st: &mut PassState) -> usize {
+        self.stats.passes += 1;
+        let mut heap: BinaryHeap<Reverse<(u64, u32, [u32; 4])>> = BinaryHeap::new();
+        for t in 0..self.w.tets.len() as u32 {
+            if self.w.alive[t as usize] && self.bad(t, target, improve) {
+                heap.push(Reverse((
+                    key(self.w.q[t as usize]),
+                    t,
+                    self.w.tets[t as usize],
+                )));
+            }
+        }
+        let mut changes = 0;
+        let mut smoothings = vec![0u8; self.w.pos.len()];
+        while let Some(Reverse((_, t, tv))) = heap.pop() {
+            if changes >= st.budget {
+                break;
+            }
+            let ti = t as usize;
+            if !self.w.alive[ti] || self.w.tets[ti] != tv || !self.bad(t, target, improve) {
+                continue;
+            }
+            if st.tried[ti] != 0 && tv.iter().all(|&v| st.stamp[v as usize] <= st.tried[ti]) {
+                continue;
+            }
+            let mut touched: Vec<u32> = vec![];
+            let mut capped = false;
+            let t0 = std::time::Instant::now();
+            let plan = self.best_plan(t);
+            self.stats.seconds_plans += t0.elapsed().as_secs_f64();
+            if let Some(plan) = plan {
+                touched = self.apply(plan);
+                st.clock += 1;
+                for &n in &touched {
+                    for v in self.w.tets[n as usize] {
+                        st.stamp[v as usize] = st.clock;
+                    }
+                }
+                for v in tv {
+                    st.stamp[v as usize] = st.clock;
+                }
+            } else {
+                for v in tv {
+                    if smoothings[v as usize] >= MAX_SMOOTHINGS {
+                        capped = true;
+                        continue;
+                    }
+                    smoothings[v as usize] += 1;
+                    self.stats.smooth_attempts += 1;
+                    let t0 = std::time::Instant::now();
+                    let ok = self.smooth(v);
+                    self.stats.seconds_smooth += t0.elapsed().as_secs_f64();
+                    if ok {
+                        touched = self.w.star[v as usize].clone();
+                        st.clock += 1;
+                        for &n in &touched {
+                            for u in self.w.tets[n as usize] {
+                                st.stamp[u as usize] = st.clock;
+                            }
+                        }
+                        break;
+                    }
+                }
+            }
+            if touched.is_empty() && !capped {
+                if let Some(plan) = self.plan_insertion(t) {
+                    touched = self.apply_insertion(plan);
+                    st.stamp.resize(self.w.pos.len(), 0);
+                    smoothings.resize(self.w.pos.len(), 0);
+                    st.clock += 1;
+                    for &n in &touched {
+                        for u in self.w.tets[n as usize] {
+                            st.stamp[u as usize] = st.clock;
+                        }
+                    }
+                }
+            }
+            if st.tried.len() < self.w.tets.len() {
+                st.tried.resize(self.w.tets.len(), 0);
+            }
+            if touched.is_empty() {
+                if !capped {
+                    st.tried[ti] = st.clock;
+                }
+                continue;
+            }
+            changes += 1;
+            for n in touched {
+                st.tried[n as usize] = 0;
+                if self.bad(n, target, improve) {
+                    heap.push(Reverse((
+                        key(self.w.q[n as usize]),
+                        n,
+                        self.w.tets[n as usize],
+                    )));
+                }
+            }
+        }
+        changes
+    }
+}
+
+/// What passes share: the work budget per pass, and the change clock (a vertex's stamp is
+/// the last change around it; a tet that nothing helped is not tried again until one of its
+/// vertices is stamped later).
+struct PassState {
+    budget: usize,
+    clock: u32,
+    stamp: Vec<u32>,
+    tried: Vec<u32>,
 }
 
 /// Fails with [`MeshError::DegenerateTet`] naming the first tet (in output order) that is
