@@ -252,18 +252,7 @@ pub fn remesh(
     let start = std::time::Instant::now();
     params.check().map_err(MeshError::InvalidInput)?;
     let plc = crate::plc::validate(input).map_err(|e| MeshError::InvalidInput(e.to_string()))?;
-    let domains = plc
-        .cells
-        .iter()
-        .filter(|c| matches!(c.kind, CellKind::Domain { .. }))
-        .count();
-    if domains > 1 || plc.regions.len() > 1 {
-        return Err(MeshError::InvalidInput(format!(
-            "surface mode approximate meshes one volume bounded by closed surfaces; this input \
-             has {domains} separate volumes or regions (facets inside the domain): use \
-             surface mode keep"
-        )));
-    }
+    check_one_volume(&plc)?;
     let surface = InputSurface::from_plc(&plc);
     let features = Features::detect(
         &surface,
@@ -292,33 +281,35 @@ pub fn remesh(
     };
     let mesher = SurfaceMesher::new(&surface, &oracle, &curves, &features.patch_of, f, criteria)?;
     let (b, volume) = mesher.run_with_volume(crit, progress)?;
-    let labels = has_labels(input);
-    let facets = b
-        .triangles
-        .iter()
-        .zip(&b.input_triangle)
-        .map(|(t, &it)| Facet {
-            polygons: vec![t.to_vec()],
-            marker: if labels {
-                surface.marker_of[it as usize]
-            } else {
-                features.patch_of[it as usize] as i32 + 1
-            },
-            ..Facet::default()
-        })
-        .collect();
-    let boundary = PlcInput {
-        vertices: b.points.clone(),
-        facets,
-        holes: input.holes.clone(),
-        regions: input.regions.clone(),
-    };
+    let boundary = boundary_plc(input, &b, &surface, &features);
     let small_corners: Vec<_> = curves
         .small_corners()
         .map(|c| (c.point, c.protect_radius))
         .collect();
-    // The boundary vertices in a small corner's protecting ball, where the surface mesher left
-    // facet angles alone and the cells are not refined (the report counts them).
+    let (small_corner_vertices, vertex_slide) = slides(&b, &curves);
+    let remeshed = Remeshed {
+        small_corner_vertices,
+        vertex_slide,
+        input_volume: plc.volume(),
+        n_corners: curves.corners.len(),
+        curves,
+        small_corners,
+        surface,
+        oracle,
+        features,
+        boundary,
+        feature_edges: b.feature_edges,
+        distance,
+        stop_reason: b.stop_reason,
+        seconds: start.elapsed().as_secs_f64(),
+    };
+    Ok((remeshed, volume))
+}
+
+/// The boundary vertices in a small corner's protecting ball, where the surface mesher left
+/// facet angles alone and the cells are not refined (the report counts them), and how each
+/// boundary vertex may slide in the improvement (not at all in such a ball).
+fn slides(b: &restricted::Boundary, curves: &FeatureCurves) -> (Vec<u32>, Vec<Slide>) {
     let in_small_corner = |p: glam::DVec3| {
         curves
             .small_corners()
@@ -338,23 +329,56 @@ pub fn remesh(
             _ => Slide::Fixed,
         })
         .collect();
-    let remeshed = Remeshed {
-        small_corner_vertices,
-        vertex_slide,
-        input_volume: plc.volume(),
-        n_corners: curves.corners.len(),
-        curves,
-        small_corners,
-        surface,
-        oracle,
-        features,
-        boundary,
-        feature_edges: b.feature_edges,
-        distance,
-        stop_reason: b.stop_reason,
-        seconds: start.elapsed().as_secs_f64(),
-    };
-    Ok((remeshed, volume))
+    (small_corner_vertices, vertex_slide)
+}
+
+/// Approximate mode meshes one volume: an input with several (separate cells, or facets
+/// inside the domain making regions) is refused, naming keep mode.
+fn check_one_volume(plc: &crate::plc::Plc) -> Result<(), MeshError> {
+    let domains = plc
+        .cells
+        .iter()
+        .filter(|c| matches!(c.kind, CellKind::Domain { .. }))
+        .count();
+    if domains > 1 || plc.regions.len() > 1 {
+        return Err(MeshError::InvalidInput(format!(
+            "surface mode approximate meshes one volume bounded by closed surfaces; this input \
+             has {domains} separate volumes or regions (facets inside the domain): use \
+             surface mode keep"
+        )));
+    }
+    Ok(())
+}
+
+/// The new boundary as a PLC: one facet per triangle, marked with the input's label of the
+/// input triangle it approximates, else with its smooth patch (numbered from 1).
+fn boundary_plc(
+    input: &PlcInput,
+    b: &restricted::Boundary,
+    surface: &InputSurface,
+    features: &Features,
+) -> PlcInput {
+    let labels = has_labels(input);
+    let facets = b
+        .triangles
+        .iter()
+        .zip(&b.input_triangle)
+        .map(|(t, &it)| Facet {
+            polygons: vec![t.to_vec()],
+            marker: if labels {
+                surface.marker_of[it as usize]
+            } else {
+                features.patch_of[it as usize] as i32 + 1
+            },
+            ..Facet::default()
+        })
+        .collect();
+    PlcInput {
+        vertices: b.points.clone(),
+        facets,
+        holes: input.holes.clone(),
+        regions: input.regions.clone(),
+    }
 }
 
 /// Whether the facet markers are the input's own labels: readers of plain surfaces number

@@ -218,7 +218,38 @@ pub(crate) fn classify(w: &mut Work, input: Option<&PlcInput>) -> (Vec<Constrain
         s != DEAD && on_seg(u, s) && on_seg(v, s)
     };
 
-    // Patches: union of same-marker triangles across non-segment edges with two triangles.
+    let mut patches = join_flat_patches(w, &seg_edge);
+    let normals = number_patches(w, &mut patches);
+
+    for v in n_input..n {
+        if w.bstar[v].is_empty() || w.star[v].is_empty() {
+            continue;
+        }
+        cons[v] = if seg_of[v] != DEAD {
+            let [a, b] = segs[seg_of[v] as usize];
+            Constraint::Line((w.p(b) - w.p(a)).normalize_or_zero())
+        } else {
+            let p = w.bpatch[w.bstar[v][0] as usize];
+            let nrm = normals[p as usize];
+            let one = w.bstar[v].iter().all(|&t| {
+                let [a, b, c] = w.btri[t as usize].map(|x| w.p(x));
+                let nt = (b - a).cross(c - a).normalize_or_zero();
+                w.bpatch[t as usize] == p && nt.dot(nrm).abs() >= MAX_PATCH_ANGLE.cos()
+            });
+            if one && nrm != DVec3::ZERO {
+                Constraint::Plane(nrm)
+            } else {
+                Constraint::Fixed
+            }
+        };
+    }
+    (cons, normals)
+}
+
+/// The flat patches: same-marker boundary triangles joined across the edges two of them share
+/// that are not on a segment and along which they are coplanar (those edges join
+/// `Work::flat_edges`).
+fn join_flat_patches(w: &mut Work, seg_edge: &dyn Fn(u32, u32) -> bool) -> UnionFind {
     let nb = w.btri.len();
     let mut edges: Vec<(u64, u32)> = Vec::with_capacity(3 * nb);
     for (i, t) in w.btri.iter().enumerate() {
@@ -251,7 +282,13 @@ pub(crate) fn classify(w: &mut Work, input: Option<&PlcInput>) -> (Vec<Constrain
         }
         i = j;
     }
-    // Patch ids in order of their smallest triangle; Newell normals oriented like it.
+    patches
+}
+
+/// Numbers the patches in order of their smallest triangle (`Work::bpatch`); returns their
+/// Newell normals, oriented like that triangle.
+fn number_patches(w: &mut Work, patches: &mut UnionFind) -> Vec<DVec3> {
+    let nb = w.btri.len();
     let mut id = vec![DEAD; nb];
     let mut normals: Vec<DVec3> = vec![];
     for t in 0..nb {
@@ -275,30 +312,7 @@ pub(crate) fn classify(w: &mut Work, input: Option<&PlcInput>) -> (Vec<Constrain
     for nrm in &mut normals {
         *nrm = nrm.normalize_or_zero();
     }
-
-    for v in n_input..n {
-        if w.bstar[v].is_empty() || w.star[v].is_empty() {
-            continue;
-        }
-        cons[v] = if seg_of[v] != DEAD {
-            let [a, b] = segs[seg_of[v] as usize];
-            Constraint::Line((w.p(b) - w.p(a)).normalize_or_zero())
-        } else {
-            let p = w.bpatch[w.bstar[v][0] as usize];
-            let nrm = normals[p as usize];
-            let one = w.bstar[v].iter().all(|&t| {
-                let [a, b, c] = w.btri[t as usize].map(|x| w.p(x));
-                let nt = (b - a).cross(c - a).normalize_or_zero();
-                w.bpatch[t as usize] == p && nt.dot(nrm).abs() >= MAX_PATCH_ANGLE.cos()
-            });
-            if one && nrm != DVec3::ZERO {
-                Constraint::Plane(nrm)
-            } else {
-                Constraint::Fixed
-            }
-        };
-    }
-    (cons, normals)
+    normals
 }
 
 /// Boundary vertices `slide` lets move get their curve's direction or their tangent plane (the

@@ -77,22 +77,10 @@ impl Improver<'_> {
                 return None;
             }
         } else {
-            let k = r.len() - 1;
-            if k + 1 > MAX_RING || !w.flat_edges.contains(&edge_key(a, b)) {
-                return None;
-            }
-            let (first, last) = (r[0], r[k]);
-            let t1 = *w.bmap.get(&key3([a, b, first]))?;
-            let t2 = *w.bmap.get(&key3([a, b, last]))?;
-            if w.bpatch[t1 as usize] == DEAD || w.bpatch[t1 as usize] != w.bpatch[t2 as usize] {
-                return None;
-            }
-            if r[1..k].iter().any(|&x| w.is_boundary_face([a, b, x])) {
-                return None;
-            }
-            boundary = self.flipped_triangles(a, b, first, last, t1, t2)?;
-            if k == 1 {
+            boundary = self.open_ring_boundary(a, b, r)?;
+            if r.len() == 2 {
                 // A flat tet on the facet: its two other faces must have a tet beyond them.
+                let (first, last) = (r[0], r[1]);
                 for f in [[a, first, last], [b, first, last]] {
                     if w.face_tets(f).1 != 2 || w.is_boundary_face(f) {
                         return None;
@@ -166,6 +154,27 @@ impl Improver<'_> {
                 Kind::BoundaryFlip
             },
         })
+    }
+
+    /// For the open ring `r` of boundary edge (a, b): the two boundary triangles that replace
+    /// (a, b, first) and (a, b, last) when the edge is removed, if it is a flat edge of one
+    /// patch, the ring is short enough, and no inner ring face is a boundary triangle.
+    fn open_ring_boundary(&self, a: u32, b: u32, r: &[u32]) -> Option<Vec<(u32, [u32; 3])>> {
+        let w = &self.w;
+        let k = r.len() - 1;
+        if k + 1 > MAX_RING || !w.flat_edges.contains(&edge_key(a, b)) {
+            return None;
+        }
+        let (first, last) = (r[0], r[k]);
+        let t1 = *w.bmap.get(&key3([a, b, first]))?;
+        let t2 = *w.bmap.get(&key3([a, b, last]))?;
+        if w.bpatch[t1 as usize] == DEAD || w.bpatch[t1 as usize] != w.bpatch[t2 as usize] {
+            return None;
+        }
+        if r[1..k].iter().any(|&x| w.is_boundary_face([a, b, x])) {
+            return None;
+        }
+        self.flipped_triangles(a, b, first, last, t1, t2)
     }
 
     /// The two triangles replacing boundary triangles t1 = (a, b, p) and t2 = (a, b, q) of one

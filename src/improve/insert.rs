@@ -40,6 +40,9 @@ impl Improver<'_> {
     /// The best insertion into a cavity around tet `t`, if one raises the worst objective.
     pub(crate) fn plan_insertion(&self, t: u32) -> Option<Insertion> {
         let w = &self.w;
+        if !w.alive[t as usize] {
+            return None;
+        }
         let region = w.region[t as usize];
         let mut x = w.points(&w.tets[t as usize]).iter().sum::<DVec3>() * 0.25;
         let mut cavity = vec![t];

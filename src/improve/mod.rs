@@ -273,58 +273,7 @@ impl Improver<'_> {
             if st.tried[ti] != 0 && tv.iter().all(|&v| st.stamp[v as usize] <= st.tried[ti]) {
                 continue;
             }
-            let mut touched: Vec<u32> = vec![];
-            let mut capped = false;
-            let t0 = std::time::Instant::now();
-            let plan = self.best_plan(t);
-            self.stats.seconds_plans += t0.elapsed().as_secs_f64();
-            if let Some(plan) = plan {
-                touched = self.apply(plan);
-                st.clock += 1;
-                for &n in &touched {
-                    for v in self.w.tets[n as usize] {
-                        st.stamp[v as usize] = st.clock;
-                    }
-                }
-                for v in tv {
-                    st.stamp[v as usize] = st.clock;
-                }
-            } else {
-                for v in tv {
-                    if smoothings[v as usize] >= MAX_SMOOTHINGS {
-                        capped = true;
-                        continue;
-                    }
-                    smoothings[v as usize] += 1;
-                    self.stats.smooth_attempts += 1;
-                    let t0 = std::time::Instant::now();
-                    let ok = self.smooth(v);
-                    self.stats.seconds_smooth += t0.elapsed().as_secs_f64();
-                    if ok {
-                        touched = self.w.star[v as usize].clone();
-                        st.clock += 1;
-                        for &n in &touched {
-                            for u in self.w.tets[n as usize] {
-                                st.stamp[u as usize] = st.clock;
-                            }
-                        }
-                        break;
-                    }
-                }
-            }
-            if touched.is_empty() && !capped {
-                if let Some(plan) = self.plan_insertion(t) {
-                    touched = self.apply_insertion(plan);
-                    st.stamp.resize(self.w.pos.len(), 0);
-                    smoothings.resize(self.w.pos.len(), 0);
-                    st.clock += 1;
-                    for &n in &touched {
-                        for u in self.w.tets[n as usize] {
-                            st.stamp[u as usize] = st.clock;
-                        }
-                    }
-                }
-            }
+            let (touched, capped) = self.work_on(t, tv, &mut smoothings, st);
             if st.tried.len() < self.w.tets.len() {
                 st.tried.resize(self.w.tets.len(), 0);
             }
@@ -350,6 +299,60 @@ impl Improver<'_> {
     }
 }
 
+impl Improver<'_> {
+    /// Tries the best flip touching tet `t` (vertices `tv`), else smoothing of its vertices,
+    /// else an insertion around it. Returns the tets made or moved (empty: nothing changed
+    /// them) and whether a vertex was skipped for its per-pass smoothing cap.
+    fn work_on(
+        &mut self,
+        t: u32,
+        tv: [u32; 4],
+        smoothings: &mut Vec<u8>,
+        st: &mut PassState,
+    ) -> (Vec<u32>, bool) {
+        let t0 = std::time::Instant::now();
+        let plan = self.best_plan(t);
+        self.stats.seconds_plans += t0.elapsed().as_secs_f64();
+        if let Some(plan) = plan {
+            // (A flat tet flipped off its facet makes no tet: `t` is gone all the same.)
+            let touched = self.apply(plan);
+            st.stamp_around(&self.w, &touched);
+            for v in tv {
+                st.stamp[v as usize] = st.clock;
+            }
+            return (touched, false);
+        }
+        let mut capped = false;
+        for v in tv {
+            if smoothings[v as usize] >= MAX_SMOOTHINGS {
+                capped = true;
+                continue;
+            }
+            smoothings[v as usize] += 1;
+            self.stats.smooth_attempts += 1;
+            let t0 = std::time::Instant::now();
+            let ok = self.smooth(v);
+            self.stats.seconds_smooth += t0.elapsed().as_secs_f64();
+            if ok {
+                let touched = self.w.star[v as usize].clone();
+                st.stamp_around(&self.w, &touched);
+                return (touched, capped);
+            }
+        }
+        if capped {
+            return (vec![], true);
+        }
+        let Some(plan) = self.plan_insertion(t) else {
+            return (vec![], false);
+        };
+        let touched = self.apply_insertion(plan);
+        st.stamp.resize(self.w.pos.len(), 0);
+        smoothings.resize(self.w.pos.len(), 0);
+        st.stamp_around(&self.w, &touched);
+        (touched, false)
+    }
+}
+
 /// What passes share: the work budget per pass, and the change clock (a vertex's stamp is
 /// the last change around it; a tet that nothing helped is not tried again until one of its
 /// vertices is stamped later).
@@ -358,6 +361,18 @@ struct PassState {
     clock: u32,
     stamp: Vec<u32>,
     tried: Vec<u32>,
+}
+
+impl PassState {
+    /// A new change: the vertices of `tets` get the next clock value.
+    fn stamp_around(&mut self, w: &Work, tets: &[u32]) {
+        self.clock += 1;
+        for &n in tets {
+            for v in w.tets[n as usize] {
+                self.stamp[v as usize] = self.clock;
+            }
+        }
+    }
 }
 
 /// Fails with [`MeshError::DegenerateTet`] naming the first tet (in output order) that is

@@ -223,9 +223,51 @@ fn strictly_inside(p: [DVec3; 4], x: DVec3) -> bool {
 /// whose own triangles share an edge another facet also uses (an interface ending inside a
 /// flat side) is left as triangles: merging would drop that edge.
 fn merge_flat_patches(vertices: &[DVec3], mut triangles: Vec<([u32; 3], i32)>) -> Vec<Facet> {
-    // Coplanar triangles get the same orientation (the merge needs it): their float normal's
-    // largest component positive.
-    for (t, _) in &mut triangles {
+    orient_by_largest_normal_component(vertices, &mut triangles);
+    let mut edge_users: FxHashMap<(u32, u32), Vec<u32>> = FxHashMap::default();
+    for (i, (t, _)) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (u, v) = (t[k], t[(k + 1) % 3]);
+            edge_users
+                .entry((u.min(v), u.max(v)))
+                .or_default()
+                .push(i as u32);
+        }
+    }
+    let mut facets = Vec::with_capacity(triangles.len());
+    for patch in flat_patches(vertices, &triangles, &edge_users) {
+        let marker = triangles[patch[0] as usize].1;
+        // An edge two triangles of the patch share but a third facet also uses.
+        let crossed = || {
+            let mut seen: FxHashMap<(u32, u32), usize> = FxHashMap::default();
+            patch.iter().any(|&i| {
+                let t = triangles[i as usize].0;
+                (0..3).any(|k| {
+                    let (u, v) = (t[k], t[(k + 1) % 3]);
+                    let key = (u.min(v), u.max(v));
+                    let n = seen.entry(key).or_insert(0);
+                    *n += 1;
+                    *n == 2 && edge_users[&key].len() > 2
+                })
+            })
+        };
+        if patch.len() == 1 || crossed() {
+            facets.extend(patch.iter().map(|&i| Facet {
+                polygons: vec![triangles[i as usize].0.to_vec()],
+                marker,
+                ..Default::default()
+            }));
+        } else {
+            facets.extend(merge_patch(vertices, &triangles, &patch, marker));
+        }
+    }
+    facets
+}
+
+/// Gives coplanar triangles the same orientation (the merge needs it): their float normal's
+/// largest component positive.
+fn orient_by_largest_normal_component(vertices: &[DVec3], triangles: &mut [([u32; 3], i32)]) {
+    for (t, _) in triangles {
         let [a, b, c] = t.map(|v| vertices[v as usize]);
         let n = (b - a).cross(c - a);
         let m = n.abs();
@@ -240,16 +282,16 @@ fn merge_flat_patches(vertices: &[DVec3], mut triangles: Vec<([u32; 3], i32)>) -
             t.swap(1, 2);
         }
     }
-    let mut edge_users: FxHashMap<(u32, u32), Vec<u32>> = FxHashMap::default();
-    for (i, (t, _)) in triangles.iter().enumerate() {
-        for k in 0..3 {
-            let (u, v) = (t[k], t[(k + 1) % 3]);
-            edge_users
-                .entry((u.min(v), u.max(v)))
-                .or_default()
-                .push(i as u32);
-        }
-    }
+}
+
+/// The flat patches: triangles with one marker joined through edges that exactly two
+/// triangles share, exactly coplanar. Each patch lists its triangles in index order, patches
+/// in the order of their root (the union-find's) first seen.
+fn flat_patches(
+    vertices: &[DVec3],
+    triangles: &[([u32; 3], i32)],
+    edge_users: &FxHashMap<(u32, u32), Vec<u32>>,
+) -> Vec<Vec<u32>> {
     let mut uf = UnionFind::new(triangles.len());
     for users in edge_users.values() {
         if let &[f, g] = &users[..] {
@@ -275,63 +317,46 @@ fn merge_flat_patches(vertices: &[DVec3], mut triangles: Vec<([u32; 3], i32)>) -
             })
             .push(i);
     }
+    order
+        .into_iter()
+        .map(|root| patches.remove(&root).unwrap_or_default())
+        .collect()
+}
 
-    let mut facets = Vec::with_capacity(triangles.len());
-    for root in order {
-        let patch = &patches[&root];
-        let marker = triangles[root as usize].1;
-        let as_triangles = |facets: &mut Vec<Facet>| {
-            facets.extend(patch.iter().map(|&i| Facet {
-                polygons: vec![triangles[i as usize].0.to_vec()],
-                marker,
-                ..Default::default()
-            }))
-        };
-        // An edge two triangles of the patch share but a third facet also uses.
-        let crossed = || {
-            let mut seen: FxHashMap<(u32, u32), usize> = FxHashMap::default();
-            patch.iter().any(|&i| {
-                let t = triangles[i as usize].0;
-                (0..3).any(|k| {
-                    let (u, v) = (t[k], t[(k + 1) % 3]);
-                    let key = (u.min(v), u.max(v));
-                    let n = seen.entry(key).or_insert(0);
-                    *n += 1;
-                    *n == 2 && edge_users[&key].len() > 2
-                })
+/// One flat patch as a PLC of its own (local vertex ids), merged into polygons, mapped back.
+fn merge_patch(
+    vertices: &[DVec3],
+    triangles: &[([u32; 3], i32)],
+    patch: &[u32],
+    marker: i32,
+) -> Vec<Facet> {
+    let mut local: FxHashMap<u32, u32> = FxHashMap::default();
+    let mut global = vec![];
+    let mut sub = PlcInput::default();
+    for &i in patch {
+        let t = triangles[i as usize].0.map(|v| {
+            *local.entry(v).or_insert_with(|| {
+                global.push(v);
+                sub.vertices.push(vertices[v as usize]);
+                global.len() as u32 - 1
             })
-        };
-        if patch.len() == 1 || crossed() {
-            as_triangles(&mut facets);
-            continue;
-        }
-        // The patch as a PLC of its own (local vertex ids), merged, mapped back.
-        let mut local: FxHashMap<u32, u32> = FxHashMap::default();
-        let mut global = vec![];
-        let mut sub = PlcInput::default();
-        for &i in patch {
-            let t = triangles[i as usize].0.map(|v| {
-                *local.entry(v).or_insert_with(|| {
-                    global.push(v);
-                    sub.vertices.push(vertices[v as usize]);
-                    global.len() as u32 - 1
-                })
-            });
-            sub.facets.push(Facet {
-                polygons: vec![t.to_vec()],
-                ..Default::default()
-            });
-        }
-        crate::plc::coplanar::merge_coplanar_facets(&mut sub);
-        let to_global = |p: Vec<u32>| p.into_iter().map(|v| global[v as usize]).collect();
-        facets.extend(sub.facets.into_iter().map(|f| Facet {
+        });
+        sub.facets.push(Facet {
+            polygons: vec![t.to_vec()],
+            ..Default::default()
+        });
+    }
+    crate::plc::coplanar::merge_coplanar_facets(&mut sub);
+    let to_global = |p: Vec<u32>| p.into_iter().map(|v| global[v as usize]).collect();
+    sub.facets
+        .into_iter()
+        .map(|f| Facet {
             polygons: f.polygons.into_iter().map(to_global).collect(),
             hole_polygons: f.hole_polygons.into_iter().map(to_global).collect(),
             hole_points: f.hole_points,
             marker,
-        }));
-    }
-    facets
+        })
+        .collect()
 }
 
 #[cfg(test)]

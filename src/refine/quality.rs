@@ -289,10 +289,7 @@ impl<'a> Refiner<'a> {
         if self.dom.flat_by_construction(bad.verts) {
             // No point inside it or at its centre can help (see `flat_by_construction`):
             // restoring the boundary around it may; else the improvement removes it.
-            if !self.resettle_near(bad.tet)? {
-                self.gave_up += 1;
-            }
-            return Ok(());
+            return self.resettle_or_give_up(bad.tet);
         }
         let near = bad.verts.iter().any(|&v| self.dom.near_acute(v));
         let [a, b, c, d] = self.dom.dt.tet_points(bad.tet);
@@ -312,10 +309,7 @@ impl<'a> Refiner<'a> {
             // boundary triangles of separate facets) and its float circumsphere is noise. A
             // point there would not remove the tet, and it would be drawn again without end;
             // only restoring the boundary around it can help.
-            if !self.resettle_near(bad.tet)? {
-                self.gave_up += 1;
-            }
-            return Ok(());
+            return self.resettle_or_give_up(bad.tet);
         }
         let centroid = (a + b + c + d) * 0.25;
         let le = longest_edge(a, b, c, d);
@@ -326,10 +320,7 @@ impl<'a> Refiner<'a> {
             // boundary elements far smaller than r (the cascade the guard below refuses), and
             // locating it costs a long walk through exact predicates. Only restoring the
             // boundary around it can help.
-            if !self.resettle_near(bad.tet)? {
-                self.gave_up += 1;
-            }
-            return Ok(());
+            return self.resettle_or_give_up(bad.tet);
         }
         // Next to a small angle shape is improved only by the circumcentre, and only when it
         // breaks no boundary: splitting the boundary there for shape would never end (the
@@ -356,10 +347,7 @@ impl<'a> Refiner<'a> {
             // Restoring the boundary around it is all that can help.
             let t = self.dom.dt.locate_point(centre, Some(bad.tet));
             if !self.dom.dt.is_finite(t) || self.dom.dt.tag(t) == 0 {
-                if !self.resettle_near(bad.tet)? {
-                    self.gave_up += 1;
-                }
-                return Ok(());
+                return self.resettle_or_give_up(bad.tet);
             }
         }
         let centre_breaks = self.encroached_boundary(centre, Some(bad.tet));
@@ -671,6 +659,14 @@ impl<'a> Refiner<'a> {
         self.settle_boundary()?;
         self.push_recent()?;
         Ok(self.dom.dt.num_vertices() > n_before)
+    }
+
+    /// [`Self::resettle_near`], counting the tet as given up when nothing was split.
+    fn resettle_or_give_up(&mut self, t: u32) -> Result<(), MeshError> {
+        if !self.resettle_near(t)? {
+            self.gave_up += 1;
+        }
+        Ok(())
     }
 
     /// Whether refinement must not split boundary element `b`: it touches a small input
