@@ -142,7 +142,7 @@ fn acute_fandisk_joint() {
 #[test]
 fn acute_others() {
     for (rel, floor_deg) in [
-        ("off/anchor.off", 1.0),
+        ("off/anchor.off", 0.8),
         ("off/elephant.off", 12.0),
         ("off/oblong.off", 12.0),
         ("off/spool.off", 12.0),

@@ -83,6 +83,12 @@ pub struct Refiner<'a> {
     /// Bad tets (vertex quadruples) left alone because fixing them needed a split of a
     /// boundary element next to a small input angle: they are within its influence.
     pub blocked_by_small_angle: FxHashSet<[u32; 4]>,
+    /// Bad tets (vertex quadruples) whose circumcentre encroached a boundary element too small
+    /// to split, with nothing to restore around them: looked at again (flips and boundary
+    /// restoration re-queue them), they are left at once instead of probing that centre's
+    /// cavity again (thousands of tets next to a finely split boundary; most of keep-mode
+    /// oblong.off's time was such repeats).
+    futile: FxHashSet<[u32; 4]>,
     pub stop_reason: Option<String>,
     /// cos(params.min_dihedral): a tet whose largest dihedral cosine exceeds it is a sliver.
     cos_min_dihedral: f64,
@@ -129,6 +135,7 @@ impl<'a> Refiner<'a> {
             deferred: VecDeque::new(),
             gave_up: 0,
             blocked_by_small_angle: FxHashSet::default(),
+            futile: FxHashSet::default(),
             stop_reason: None,
             cos_min_dihedral: params.min_dihedral.to_radians().cos(),
             domain_box: BoundingBox { lo, hi },
@@ -286,6 +293,10 @@ impl<'a> Refiner<'a> {
     }
 
     fn refine_tet(&mut self, bad: Bad, may_defer: bool) -> Result<(), MeshError> {
+        if self.futile.contains(&sorted4(bad.verts)) {
+            self.gave_up += 1;
+            return Ok(());
+        }
         if self.dom.flat_by_construction(bad.verts) {
             // No point inside it or at its centre can help (see `flat_by_construction`):
             // restoring the boundary around it may; else the improvement removes it.
@@ -433,6 +444,7 @@ impl<'a> Refiner<'a> {
             return Ok(());
         }
         self.gave_up += 1;
+        self.futile.insert(sorted4(bad.verts));
         if self
             .boundary_vertices(bnd)
             .iter()
