@@ -9,7 +9,7 @@
 //! old ones, so (a degree argument) they tile the same polyhedron.
 
 use super::quality::objective;
-use super::topo::{edge_key, key3, Work, DEAD};
+use super::topo::{edge_key, face, key3, Work, DEAD};
 use super::Improver;
 
 /// Longest ring edge removal considers (the table is O(n^3)).
@@ -299,8 +299,7 @@ impl Improver<'_> {
             }
         }
         for i in 0..4 {
-            let f = [tv[(i + 1) % 4], tv[(i + 2) % 4], tv[(i + 3) % 4]];
-            consider(self.plan_face(f));
+            consider(self.plan_face(face(tv, i)));
         }
         best
     }

@@ -14,7 +14,7 @@
 
 use super::constraints::Constraint;
 use super::flips::MIN_GAIN;
-use super::topo::DEAD;
+use super::topo::{face, DEAD};
 use super::Improver;
 use glam::DVec3;
 
@@ -53,7 +53,7 @@ impl Improver<'_> {
         }
         let mut best: Option<Insertion> = None;
         for _ in 0..MAX_GROWTH {
-            let (make, from) = self.cone(&cavity);
+            let (make, from) = self.cone(&cavity, region);
             let old = cavity
                 .iter()
                 .map(|&c| w.q[c as usize])
@@ -110,20 +110,18 @@ impl Improver<'_> {
         (n == 2 && w.region[nb as usize] == region).then_some(nb)
     }
 
-    /// The new tets joining `NEW` to the outer faces of `cavity` (each a cavity tet with the
-    /// vertex opposite that face replaced), with the (cavity tet, face) each comes from.
-    fn cone(&self, cavity: &[u32]) -> (Vec<[u32; 4]>, Vec<(u32, usize)>) {
-        let w = &self.w;
+    /// The new tets joining `NEW` to the outer faces of `cavity` (tets of region `region`;
+    /// each new tet is a cavity tet with the vertex opposite that face replaced), with the
+    /// (cavity tet, face) each comes from.
+    fn cone(&self, cavity: &[u32], region: i32) -> (Vec<[u32; 4]>, Vec<(u32, usize)>) {
         let mut make = vec![];
         let mut from = vec![];
         for &c in cavity {
-            let tv = w.tets[c as usize];
+            let tv = self.w.tets[c as usize];
             for i in 0..4 {
-                let f = face(tv, i);
-                let inner = !w.is_boundary_face(f) && {
-                    let (pair, n) = w.face_tets(f);
-                    n == 2 && cavity.contains(if pair[0] == c { &pair[1] } else { &pair[0] })
-                };
+                let inner = self
+                    .beyond(c, i, region)
+                    .is_some_and(|nb| cavity.contains(&nb));
                 if !inner {
                     let mut nt = tv;
                     nt[i] = NEW;
@@ -151,9 +149,4 @@ impl Improver<'_> {
             })
             .collect()
     }
-}
-
-/// Face `i` of tet `tv` (the one opposite its vertex `i`).
-fn face(tv: [u32; 4], i: usize) -> [u32; 3] {
-    [tv[(i + 1) % 4], tv[(i + 2) % 4], tv[(i + 3) % 4]]
 }

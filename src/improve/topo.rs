@@ -42,6 +42,12 @@ pub(crate) struct Work {
     pub rho_weight: f64,
 }
 
+/// Face `i` of tet `tv` (the one opposite its vertex `i`).
+#[inline]
+pub(crate) fn face(tv: [u32; 4], i: usize) -> [u32; 3] {
+    [tv[(i + 1) % 4], tv[(i + 2) % 4], tv[(i + 3) % 4]]
+}
+
 /// The key of edge (a, b) in `Work::flat_edges`.
 #[inline]
 pub(crate) fn edge_key(a: u32, b: u32) -> u64 {
