@@ -11,6 +11,15 @@ fn vol(m: &TetMesh) -> f64 {
         .sum()
 }
 
+/// `t` with its last two vertices swapped if it is negatively oriented.
+fn positively_oriented(mut t: [u32; 4], vertices: &[DVec3]) -> [u32; 4] {
+    let p = t.map(|v| vertices[v as usize]);
+    if orient3d(p[0], p[1], p[2], p[3]) < 0.0 {
+        t.swap(2, 3);
+    }
+    t
+}
+
 fn min_q(m: &TetMesh) -> f64 {
     m.tets
         .iter()
@@ -38,12 +47,7 @@ fn three_two_flip_removes_a_long_edge() {
     let mut tets = vec![];
     for i in 0..3u32 {
         let (x, y) = (2 + i, 2 + (i + 1) % 3);
-        let mut t = [0, 1, x, y];
-        let p = t.map(|v| vertices[v as usize]);
-        if orient3d(p[0], p[1], p[2], p[3]) < 0.0 {
-            t.swap(2, 3);
-        }
-        tets.push(t);
+        tets.push(positively_oriented([0, 1, x, y], &vertices));
     }
     // Stretch the edge so the three tets are needles around it.
     vertices[0].z = -6.0;
@@ -340,16 +344,11 @@ fn insertion_lifts_a_flat_tet_off_a_fold() {
     ];
     // The flat tet (lower faces abc, bcd on the hull) and the two tets above its upper faces
     // abd, acd.
-    let mut tets = vec![[0, 1, 2, 3], [0, 1, 3, 4], [0, 2, 3, 4]];
-    for t in &mut tets {
-        let p = t.map(|v| vertices[v as usize]);
-        if orient3d(p[0], p[1], p[2], p[3]) < 0.0 {
-            t.swap(2, 3);
-        }
-    }
+    let tets =
+        [[0, 1, 2, 3], [0, 1, 3, 4], [0, 2, 3, 4]].map(|t| positively_oriented(t, &vertices));
     let mesh = TetMesh {
         vertices,
-        tets,
+        tets: tets.to_vec(),
         tet_regions: vec![1; 3],
         ..Default::default()
     };
