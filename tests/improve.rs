@@ -136,8 +136,8 @@ fn acute_part() {
 }
 #[test]
 fn acute_fandisk_joint() {
-    acute("off/fandisk.off", 15.0);
-    acute("off/joint.off", 8.0);
+    acute("off/fandisk.off", 17.0);
+    acute("off/joint.off", 12.0);
 }
 #[test]
 fn acute_others() {

@@ -9,7 +9,9 @@
 //! directions inside the group). The boundary edges are chained into loops: the loop whose
 //! signed area along the group normal is positive becomes the facet's polygon, the others
 //! (clockwise: inner boundaries) become `hole_polygons`, in the order they were traced.
-//! Collinear intermediate vertices are kept: they are PLC vertices anyway.
+//! Collinear intermediate vertices are kept: they are PLC vertices anyway. A vertex inside the
+//! group (on no boundary loop) becomes a lone point of the merged facet (a one-vertex polygon):
+//! the facet's triangulation keeps it as a vertex, with no segment attached to it.
 //!
 //! A group is left unmerged (its facets are kept as they were) when its boundary is not a set of
 //! simple loops: a vertex with two outgoing boundary edges (patches touching at a vertex), or
@@ -176,7 +178,7 @@ fn newell(pts: &[DVec3]) -> DVec3 {
 }
 
 /// The merged facet of a group, or `None` when its boundary is not a set of simple loops with
-/// exactly one outer loop, or when a vertex lies inside the patch.
+/// exactly one outer loop.
 fn merge_group(group: &[usize], facets: &[Facet], verts: &[DVec3], normal: DVec3) -> Option<Facet> {
     let directed = || {
         group.iter().flat_map(|&fi| {
@@ -237,17 +239,16 @@ fn merge_group(group: &[usize], facets: &[Facet], verts: &[DVec3], normal: DVec3
             holes.push(lp);
         }
     }
-    // A vertex inside the patch (on no boundary loop) would be lost from the merged polygon:
-    // keep such a patch as its triangles.
-    if group
-        .iter()
-        .flat_map(|&fi| facets[fi].polygons[0].iter())
-        .any(|v| !used.contains_key(v))
-    {
-        return None;
+    // A vertex inside the patch (on no boundary loop) stays a vertex of the facet as a lone
+    // point (a one-vertex polygon), in order of first use.
+    let mut polygons = vec![outer?];
+    for &v in group.iter().flat_map(|&fi| facets[fi].polygons[0].iter()) {
+        if used.insert(v, true).is_none() {
+            polygons.push(vec![v]);
+        }
     }
     Some(Facet {
-        polygons: vec![outer?],
+        polygons,
         hole_points: Vec::new(),
         hole_polygons: holes,
         marker: 0,
@@ -288,12 +289,23 @@ mod tests {
     }
 
     #[test]
-    fn flat_grid_with_interior_vertices_is_left_unmerged() {
-        // Its four interior vertices would vanish from a merged polygon (and then lie on the
-        // facet without being its vertices): the patch keeps its 18 triangles.
+    fn flat_grid_keeps_its_interior_vertices_as_lone_points() {
+        // One facet: the 12 boundary vertices in a loop, the 4 interior ones as lone points,
+        // which the checked facet's triangulation uses (18 triangles, no segment at them).
         let mut plc = grid(false);
         merge_coplanar_facets(&mut plc);
-        assert_eq!(plc.facets.len(), 18);
+        assert_eq!(plc.facets.len(), 1);
+        let f = &plc.facets[0];
+        assert_eq!(f.polygons[0].len(), 12);
+        let mut lone: Vec<u32> = f.polygons[1..].iter().map(|p| p[0]).collect();
+        lone.sort_unstable();
+        assert_eq!(lone, vec![5, 6, 9, 10]);
+        assert!(f.polygons[1..].iter().all(|p| p.len() == 1));
+        let checked = crate::plc::check_facet(0, f, &plc.vertices).unwrap();
+        assert_eq!(checked.triangles.len(), 18);
+        assert!(checked
+            .segments()
+            .all(|s| !lone.contains(&s[0]) && !lone.contains(&s[1])));
     }
 
     #[test]

@@ -74,8 +74,16 @@ pub enum PlcError {
         index: u32,
         num_vertices: usize,
     },
-    /// A polygon with fewer than 3 vertices.
+    /// A polygon with 2 vertices, or a hole polygon with fewer than 3 (an outer polygon of one
+    /// vertex is a lone point of the facet).
     TooFewVertices { polygon: PolygonRef, count: usize },
+    /// A lone point of a facet (a one-vertex polygon) lies on one of its polygon edges or
+    /// outside the region the facet covers.
+    LonePointOffFacet {
+        polygon: PolygonRef,
+        vertex: u32,
+        on_edge: bool,
+    },
     /// A vertex id appears twice in one polygon.
     RepeatedVertex { polygon: PolygonRef, vertex: u32 },
     /// The facet's vertices are (numerically) collinear: it has no plane.
@@ -196,9 +204,24 @@ impl fmt::Display for PlcError {
             TooFewVertices { polygon, count } => {
                 write!(
                     f,
-                    "{polygon} has {count} vertices; a polygon needs at least 3"
+                    "{polygon} has {count} vertices; a polygon needs at least 3 (or 1: a \
+                     point inside the facet)"
                 )
             }
+            LonePointOffFacet {
+                polygon,
+                vertex,
+                on_edge,
+            } => write!(
+                f,
+                "{polygon} is the single vertex {vertex}, which lies {} the facet: a lone \
+                 point must be strictly inside it",
+                if *on_edge {
+                    "on a polygon edge of"
+                } else {
+                    "outside"
+                }
+            ),
             RepeatedVertex { polygon, vertex } => {
                 write!(f, "{polygon} repeats vertex {vertex}")
             }

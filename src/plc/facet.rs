@@ -116,11 +116,19 @@ pub fn build_facet(k: usize, facet: &Facet, vertices: &[DVec3]) -> Result<PlcFac
     for &(r, p) in &polygons {
         check_polygon(r, p, vertices.len())?;
     }
+    // One-vertex outer polygons are lone points: vertices of the triangulation, no edges.
+    let (lone, polygons): (Vec<_>, Vec<_>) = polygons.into_iter().partition(|(_, p)| p.len() == 1);
+    if polygons
+        .first()
+        .is_none_or(|(r, _)| r.kind != PolygonKind::Outer)
+    {
+        return Err(PlcError::EmptyFacet { facet: k });
+    }
 
     // Facet-local vertex numbering, in order of first appearance.
     let mut global: Vec<u32> = Vec::new();
     let mut local: FxHashMap<u32, usize> = FxHashMap::default();
-    for &(_, p) in &polygons {
+    for &(_, p) in polygons.iter().chain(&lone) {
         for &v in p {
             local.entry(v).or_insert_with(|| {
                 global.push(v);
@@ -172,6 +180,7 @@ pub fn build_facet(k: usize, facet: &Facet, vertices: &[DVec3]) -> Result<PlcFac
         }
     }
     check_simple(&p2, &edges, &global)?;
+    check_lone_points_off_edges(&lone, &p2, &edges, &local)?;
 
     let cdt = Cdt::bulk_load_cdt(
         p2.iter().map(|p| Point2::new(p[0], p[1])).collect(),
@@ -206,6 +215,7 @@ pub fn build_facet(k: usize, facet: &Facet, vertices: &[DVec3]) -> Result<PlcFac
         area += (b - a).cross(c - a).length() / 2.0;
         triangles.push(t);
     }
+    check_lone_points_covered(&lone, &triangles)?;
     let facet = PlcFacet {
         marker: facet.marker,
         plane,
@@ -234,7 +244,8 @@ fn check_polygon(r: PolygonRef, p: &[u32], num_vertices: usize) -> Result<(), Pl
             });
         }
     }
-    if p.len() < 3 {
+    let lone_point = p.len() == 1 && r.kind == PolygonKind::Outer;
+    if p.len() < 3 && !lone_point {
         return Err(PlcError::TooFewVertices {
             polygon: r,
             count: p.len(),
@@ -249,6 +260,47 @@ fn check_polygon(r: PolygonRef, p: &[u32], num_vertices: usize) -> Result<(), Pl
         });
     }
     Ok(())
+}
+
+/// A lone point exactly on a polygon edge (exact, in the projection every check here uses).
+fn check_lone_points_off_edges(
+    lone: &[(PolygonRef, &[u32])],
+    p2: &[P2],
+    edges: &[LocalEdge],
+    local: &FxHashMap<u32, usize>,
+) -> Result<(), PlcError> {
+    for &(r, p) in lone {
+        let q = p2[local[&p[0]]];
+        let on = |e: &LocalEdge| {
+            let (a, b) = (p2[e.a], p2[e.b]);
+            let within = |i: usize| a[i].min(b[i]) <= q[i] && q[i] <= a[i].max(b[i]);
+            orient2d(a, b, q) == Ordering::Equal && within(0) && within(1)
+        };
+        if edges.iter().any(on) {
+            return Err(PlcError::LonePointOffFacet {
+                polygon: r,
+                vertex: p[0],
+                on_edge: true,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// A lone point that no covered triangle uses lies outside the facet (or in a hole).
+fn check_lone_points_covered(
+    lone: &[(PolygonRef, &[u32])],
+    triangles: &[[u32; 3]],
+) -> Result<(), PlcError> {
+    let used: FxHashSet<u32> = triangles.iter().flatten().copied().collect();
+    match lone.iter().find(|(_, p)| !used.contains(&p[0])) {
+        Some(&(r, p)) => Err(PlcError::LonePointOffFacet {
+            polygon: r,
+            vertex: p[0],
+            on_edge: false,
+        }),
+        None => Ok(()),
+    }
 }
 
 fn lex(a: P2, b: P2) -> Ordering {

@@ -110,7 +110,8 @@ impl Domain {
         let mut subfacets = FxHashMap::default();
         for (fi, f) in input.facets.iter().enumerate() {
             let loops = f.polygons.iter().chain(f.hole_polygons.iter());
-            for poly in loops {
+            // A one-vertex polygon is a lone point: no segment.
+            for poly in loops.filter(|p| p.len() > 1) {
                 for k in 0..poly.len() {
                     let key = seg_key(poly[k], poly[(k + 1) % poly.len()]);
                     let s = *seg_index.entry(key).or_insert_with(|| {

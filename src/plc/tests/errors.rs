@@ -112,6 +112,43 @@ fn polygon_with_fewer_than_three_vertices() {
     has(&msg, &["polygon 1 of facet 1", "2 vertices"]);
 }
 
+/// The unit cube with vertex 8 at `p` added to facet 0 (z = 0) as a lone point.
+fn cube_with_lone_point(p: DVec3) -> PlcInput {
+    let mut input = unit_cube();
+    input.vertices.push(p);
+    input.facets[0].polygons.push(vec![8]);
+    input
+}
+
+#[test]
+fn lone_point_inside_a_facet_is_a_triangulation_vertex() {
+    let plc = validate(&cube_with_lone_point(DVec3::new(0.25, 0.5, 0.0))).unwrap();
+    let f = &plc.facets[0];
+    assert_eq!(f.triangles.iter().filter(|t| t.contains(&8)).count(), 4);
+    assert!(f.segments().all(|s| !s.contains(&8)));
+    assert!(plc.isolated_vertices.is_empty());
+    assert!((plc.volume() - 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn lone_point_on_an_edge_or_outside_its_facet() {
+    for (p, on_edge, place) in [
+        (DVec3::new(0.5, 0.0, 0.0), true, "on a polygon edge"),
+        (DVec3::new(2.0, 0.5, 0.0), false, "outside"),
+    ] {
+        let (e, msg) = fails(&cube_with_lone_point(p));
+        assert_eq!(
+            e,
+            PlcError::LonePointOffFacet {
+                polygon: outer(0, 1),
+                vertex: 8,
+                on_edge
+            }
+        );
+        has(&msg, &["polygon 1 of facet 0", "vertex 8", place]);
+    }
+}
+
 #[test]
 fn repeated_vertex_in_polygon() {
     let mut input = unit_cube();
