@@ -128,7 +128,7 @@ fn acute(rel: &str, floor_deg: f64) {
 
 #[test]
 fn acute_rotor() {
-    acute("off/rotor.off", 8.0);
+    acute("off/rotor.off", 1.5);
 }
 #[test]
 fn acute_part() {

@@ -90,6 +90,71 @@ impl Domain {
         Ok(regions)
     }
 
+    /// Gives the tets in `created` (made since the boundary was last complete) the tag of the
+    /// old tets they touch: each group of them joined across faces that are not subfacets takes
+    /// the tag of an old neighbour across such a face. A new tet inherits the tag of the cavity
+    /// tet that held its outer face, which is wrong where the cavity crossed a subfacet that a
+    /// boundary split had deleted for a moment; without this, region labels leak (thousands of
+    /// exterior tets labelled inside on the curved models) until the next whole re-marking.
+    /// A group whose old neighbours disagree keeps its tags. Returns the tets re-tagged.
+    pub fn retag_created(&mut self, created: &[u32]) -> usize {
+        let mut index: rustc_hash::FxHashMap<u32, u32> = rustc_hash::FxHashMap::default();
+        let mut tets = Vec::with_capacity(created.len());
+        for &t in created {
+            if self.dt.is_alive(t) && !index.contains_key(&t) {
+                index.insert(t, tets.len() as u32);
+                tets.push(t);
+            }
+        }
+        let mut uf = UnionFind::new(tets.len());
+        for (i, &t) in tets.iter().enumerate() {
+            for (k, n) in self.dt.neighbors(t).into_iter().enumerate() {
+                if let Some(&j) = index.get(&n) {
+                    if !self.is_subfacet(FACE[k].map(|x| self.dt.tet(t)[x])) {
+                        uf.union(i as u32, j);
+                    }
+                }
+            }
+        }
+        // Per group root: the tag its old neighbours agree on (None: they disagree).
+        let mut tag_of: rustc_hash::FxHashMap<u32, Option<u32>> = Default::default();
+        for (i, &t) in tets.iter().enumerate() {
+            let v = self.dt.tet(t);
+            for (k, n) in self.dt.neighbors(t).into_iter().enumerate() {
+                if index.contains_key(&n) || self.is_subfacet(FACE[k].map(|x| v[x])) {
+                    continue;
+                }
+                let tag = self.dt.tag(n);
+                tag_of
+                    .entry(uf.find(i as u32))
+                    .and_modify(|g| {
+                        if *g != Some(tag) {
+                            *g = None;
+                        }
+                    })
+                    .or_insert(Some(tag));
+            }
+        }
+        let mut changed = 0;
+        for (i, &t) in tets.iter().enumerate() {
+            if let Some(&Some(tag)) = tag_of.get(&uf.find(i as u32)) {
+                if self.dt.tag(t) != tag {
+                    self.dt.set_tag(t, tag);
+                    changed += 1;
+                }
+            }
+        }
+        changed
+    }
+
+    /// Whether face f (three vertex ids) is a subfacet.
+    fn is_subfacet(&self, f: [u32; 3]) -> bool {
+        !f.contains(&INFINITE)
+            && f.iter()
+                .all(|&x| self.kind[x as usize] != VertexKind::Volume)
+            && self.subfacets.contains_key(&tri_key(f))
+    }
+
     /// The components of the triangulation bounded by subfacets: the component of every tet
     /// slot (numbered in the order of their smallest tet id; dead slots: whatever) and, per
     /// component, whether it touches the hull.

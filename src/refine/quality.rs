@@ -236,6 +236,7 @@ impl<'a> Refiner<'a> {
     /// Queues the bad tets among those created since the last call.
     fn push_recent(&mut self) -> Result<(), MeshError> {
         let recent = std::mem::take(&mut self.dom.created_log);
+        self.dom.retag_created(&recent);
         self.push_tets(&recent)
     }
 
