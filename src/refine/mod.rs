@@ -271,9 +271,9 @@ pub struct Report {
     pub n_acute_angles: usize,
     /// Tets left violating a bound because they are within the influence of an acute angle.
     pub n_bad_near_acute: usize,
-    /// Tets whose region (or inside/outside status) the re-marking after a refinement pass
-    /// corrected: the labels tets inherit through cavities leaked across the boundary (a
-    /// cavity that crosses a subfacet for a moment). 0 on every acute-free model.
+    /// Tets whose region (or inside/outside status) the check after refinement corrected:
+    /// refinement keeps the labels incrementally (`Domain::retag_created`), so this is 0 unless
+    /// that invariant broke (then one more pass refined them). 0 on every shared model.
     pub n_relabelled: usize,
     /// Whether every bound holds everywhere it is enforced (false when a budget stopped it).
     pub complete: bool,
@@ -381,19 +381,6 @@ impl std::fmt::Display for MeshError {
 }
 impl std::error::Error for MeshError {}
 
-/// The region tag of every tet slot (dead slots: u32::MAX).
-fn tet_tags(dom: &domain::Domain) -> Vec<u32> {
-    (0..dom.dt.tet_capacity() as u32)
-        .map(|t| {
-            if dom.dt.is_alive(t) {
-                dom.dt.tag(t)
-            } else {
-                u32::MAX
-            }
-        })
-        .collect()
-}
-
 /// The region of every tet slot as the output would give it: its attribute, None outside the
 /// domain (and for dead slots).
 fn tet_labels(dom: &domain::Domain, regions: &mark::Regions) -> Vec<Option<i32>> {
@@ -404,10 +391,6 @@ fn tet_labels(dom: &domain::Domain, regions: &mark::Regions) -> Vec<Option<i32>>
         })
         .collect()
 }
-
-/// Refinement passes at most (each re-marks regions and re-checks every tet; the second pass
-/// almost always finds nothing to do).
-const MAX_PASSES: usize = 4;
 
 /// Progress callback: (fraction done estimate in [0, 1], current vertex count) -> keep going?
 pub type Progress<'a> = &'a mut dyn FnMut(f64, usize) -> bool;
@@ -516,11 +499,11 @@ struct Passes {
     stop_reason: Option<String>,
     /// Bad tets left within a small angle's influence (sorted vertex quadruples).
     blocked: FxHashSet<[u32; 4]>,
-    /// Tets whose region the re-marking after a pass corrected (`Report::n_relabelled`).
+    /// Tets whose region the check after refinement corrected (`Report::n_relabelled`).
     n_relabelled: usize,
 }
 
-/// The inputs of [`refine_passes`] that stay fixed across passes.
+/// The inputs of [`refine_passes`].
 struct PassContext<'a> {
     input: &'a PlcInput,
     params: &'a Params,
@@ -529,9 +512,12 @@ struct PassContext<'a> {
     budget: &'a mut usize,
 }
 
-/// Runs refinement passes (the bad-tet queues, then a whole-boundary check and re-marking of
-/// the regions, `regions` updated) until one changes nothing; see ARCHITECTURE.md for why the
-/// re-marking stays.
+/// Runs refinement (the bad-tet queues), then checks what it keeps incrementally: the whole
+/// boundary is present and unencroached (`recover_boundary` inserts nothing) and every tet
+/// carries its region (`Domain::retag_created`: the re-marking from the seeds, which updates
+/// `regions`, changes no label). Should the check change something (it never has on the shared
+/// models; the tests assert it), one more refinement pass looks at every tet again, and the
+/// report counts the relabelled tets.
 fn refine_passes(
     dom: &mut domain::Domain,
     ctx: &mut PassContext,
@@ -546,33 +532,23 @@ fn refine_passes(
     };
     let max_v = ctx.params.max_vertices.max(1) as f64;
     let mut on_step = |n: usize| progress((n as f64 / max_v).min(1.0), n);
-    for _pass in 0..MAX_PASSES {
-        let before = dom.dt.num_vertices();
+    for _ in 0..2 {
         dom.created_log.clear();
         let mut r = quality::Refiner::new(dom, ctx.params, ctx.spacing, regions);
         r.run(&mut on_step)?;
         out.stop_reason = r.stop_reason.take();
         out.blocked.extend(r.blocked_by_small_angle.drain());
-        // A boundary split can delete a subfacet of another facet for a moment, letting
-        // region labels leak across it: check the whole boundary, re-mark from the seeds
-        // and look at every tet again until a pass changes nothing.
         let refined = dom.dt.num_vertices();
-        let tags = tet_tags(dom);
         let labels = tet_labels(dom, regions);
         dom.recover_boundary(ctx.budget)?;
         *regions = dom.mark_domain(ctx.input, ctx.unseeded)?;
-        out.n_relabelled += labels
+        let relabelled = labels
             .iter()
             .zip(tet_labels(dom, regions))
             .filter(|(old, new)| **old != *new)
             .count();
-        if out.stop_reason.is_some() || dom.dt.num_vertices() == before {
-            break;
-        }
-        // Every tet was classified when it was made and the queues are empty: when the
-        // check and the re-marking changed nothing, another pass would only meet the
-        // tets already left alone.
-        if dom.dt.num_vertices() == refined && tet_tags(dom) == tags {
+        out.n_relabelled += relabelled;
+        if out.stop_reason.is_some() || (dom.dt.num_vertices() == refined && relabelled == 0) {
             break;
         }
     }
