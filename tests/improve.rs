@@ -36,6 +36,18 @@ fn check_kept(rel: &str, m: &TetMesh) {
         );
     }
     check_on_input_surface(rel, &input, m);
+    // Input vertices keep their ids and places; deleted ones are dropped from the output.
+    assert_eq!(
+        m.vertices[..input.vertices.len()],
+        input.vertices[..],
+        "{rel}: input vertices"
+    );
+    let mut used = vec![false; m.vertices.len()];
+    m.tets
+        .iter()
+        .flatten()
+        .for_each(|&v| used[v as usize] = true);
+    assert!(used.iter().all(|&u| u), "{rel}: a vertex no tet uses");
     if let Some(v) = enclosed_volume(&input) {
         let vol = total_volume(m);
         assert!(rel_close(vol, v, 1e-9), "{rel}: volume {vol}, expected {v}");
@@ -128,7 +140,7 @@ fn acute(rel: &str, floor_deg: f64) {
 
 #[test]
 fn acute_rotor() {
-    acute("off/rotor.off", 1.5);
+    acute("off/rotor.off", 8.0);
 }
 #[test]
 fn acute_part() {

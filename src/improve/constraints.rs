@@ -197,6 +197,8 @@ pub(crate) fn classify(w: &mut Work, input: Option<&PlcInput>) -> (Vec<Constrain
         return (cons, vec![]);
     };
     let n_input = input.vertices.len().min(n);
+    // Input vertices never move (nor are deleted), interior ones included.
+    cons[..n_input].fill(Constraint::Fixed);
     let segs = segments(input);
     let seg_of = segment_of(w, n_input, &segs);
     let on_seg = |v: u32, s: u32| -> bool {

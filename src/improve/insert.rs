@@ -63,6 +63,7 @@ impl Improver<'_> {
             x = at;
             if new_min > old + MIN_GAIN
                 && best.as_ref().is_none_or(|b| new_min > b.new_min)
+                && self.swallows_only_free(&cavity, &make)
                 && make.iter().all(|t| {
                     let p = t.map(|v| if v == NEW { at } else { w.p(v) });
                     crate::geom::orient3d(p[0], p[1], p[2], p[3]) > 0.0
@@ -133,20 +134,49 @@ impl Improver<'_> {
         (make, from)
     }
 
-    /// Carries an insertion out; returns the new tets.
+    /// Whether every vertex the cone leaves out (all its tets in the cavity) is a free
+    /// interior vertex: the insertion deletes it.
+    fn swallows_only_free(&self, cavity: &[u32], make: &[[u32; 4]]) -> bool {
+        cavity
+            .iter()
+            .flat_map(|&c| self.w.tets[c as usize])
+            .all(|u| {
+                matches!(self.cons[u as usize], Constraint::Free)
+                    || make.iter().any(|t| t.contains(&u))
+            })
+    }
+
+    /// Carries an insertion out; returns the new tets. A free vertex the cavity swallowed
+    /// (every tet of it was in the cavity) is deleted.
     pub(crate) fn apply_insertion(&mut self, plan: Insertion) -> Vec<u32> {
         let v = self.w.add_vertex(plan.at);
         self.cons.push(Constraint::Free);
+        let mut old: Vec<u32> = plan
+            .kill
+            .iter()
+            .flat_map(|&t| self.w.tets[t as usize])
+            .collect();
+        old.sort_unstable();
+        old.dedup();
         for &t in &plan.kill {
             self.w.kill_tet(t);
         }
         self.stats.insertions += 1;
-        plan.make
+        let made = plan
+            .make
             .iter()
             .map(|t| {
                 let t = t.map(|u| if u == NEW { v } else { u });
                 self.w.add_tet(t, plan.region)
             })
-            .collect()
+            .collect();
+        for u in old {
+            if self.w.star[u as usize].is_empty() {
+                self.cons[u as usize] = Constraint::Fixed;
+                self.w.deleted.push(u);
+                self.stats.deletions += 1;
+            }
+        }
+        made
     }
 }

@@ -21,6 +21,7 @@
 //! anything, so the result is deterministic.
 
 mod constraints;
+mod delete;
 mod flips;
 mod insert;
 pub mod quality;
@@ -72,6 +73,9 @@ pub struct Stats {
     pub smoothed: usize,
     /// Vertices inserted where flips and smoothing left a tet bad.
     pub insertions: usize,
+    /// Free interior vertices removed: contracted onto a neighbour where that did better than
+    /// an insertion, or swallowed by an insertion's cavity.
+    pub deletions: usize,
     /// Vertices smoothing was tried on (`smoothed` of them moved).
     pub smooth_attempts: usize,
     pub passes: usize,
@@ -86,7 +90,13 @@ pub struct Stats {
 impl Stats {
     /// Whether the mesh was changed at all.
     pub fn changed(&self) -> bool {
-        self.edge_removals + self.face_removals + self.boundary_flips + self.smoothed > 0
+        self.edge_removals
+            + self.face_removals
+            + self.boundary_flips
+            + self.smoothed
+            + self.insertions
+            + self.deletions
+            > 0
     }
 }
 
@@ -301,7 +311,7 @@ impl Improver<'_> {
 
 impl Improver<'_> {
     /// Tries the best flip touching tet `t` (vertices `tv`), else smoothing of its vertices,
-    /// else an insertion around it. Returns the tets made or moved (empty: nothing changed
+    /// else an insertion around it or the deletion of one of its vertices, whichever is better. Returns the tets made or moved (empty: nothing changed
     /// them) and whether a vertex was skipped for its per-pass smoothing cap.
     fn work_on(
         &mut self,
@@ -342,10 +352,14 @@ impl Improver<'_> {
         if capped {
             return (vec![], true);
         }
-        let Some(plan) = self.plan_insertion(t) else {
-            return (vec![], false);
+        let insertion = self.plan_insertion(t);
+        let deletion = self.plan_deletion(t);
+        let touched = match (insertion, deletion) {
+            (Some(i), Some(d)) if d.new_min > i.new_min => self.apply_deletion(d),
+            (Some(i), _) => self.apply_insertion(i),
+            (None, Some(d)) => self.apply_deletion(d),
+            (None, None) => return (vec![], false),
         };
-        let touched = self.apply_insertion(plan);
         st.stamp.resize(self.w.pos.len(), 0);
         smoothings.resize(self.w.pos.len(), 0);
         st.stamp_around(&self.w, &touched);

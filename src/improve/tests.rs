@@ -377,3 +377,51 @@ fn insertion_lifts_a_flat_tet_off_a_fold() {
     assert!(out.tet_regions.iter().all(|&r| r == 1));
     check_no_degenerate(&out).unwrap();
 }
+
+/// A free vertex just below one face of a regular-ish tet, joined to its four faces: the three
+/// tets on that face side are flat, and the vertex goes (contracted onto a corner), leaving the
+/// one good tet; the deleted vertex is dropped from the output.
+#[test]
+fn deletion_removes_a_vertex_squeezed_against_a_face() {
+    let vertices = vec![
+        DVec3::new(0.0, 0.0, 0.0),
+        DVec3::new(1.0, 0.0, 0.0),
+        DVec3::new(0.5, 0.9, 0.0),
+        DVec3::new(0.5, 0.3, 0.8),
+        DVec3::new(0.5, 0.3, 1e-3),
+    ];
+    let tets = [[1, 2, 3, 4], [0, 2, 3, 4], [0, 1, 3, 4], [0, 1, 2, 4]]
+        .map(|t| positively_oriented(t, &vertices));
+    let mesh = TetMesh {
+        vertices,
+        tets: tets.to_vec(),
+        tet_regions: vec![7; 4],
+        boundary: vec![[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]],
+        boundary_markers: vec![1; 4],
+    };
+    let before = min_q(&mesh);
+    assert!(before < 1e-2);
+    let mut w = topo::Work::new(&mesh, f64::INFINITY);
+    let (cons, normals) = constraints::classify(&mut w, None);
+    assert!(matches!(cons[4], Constraint::Free) && matches!(cons[0], Constraint::Fixed));
+    let mut im = Improver {
+        w,
+        cons,
+        normals,
+        slide: None,
+        stats: Stats::default(),
+    };
+    let worst = (0..4u32)
+        .min_by(|&a, &b| im.w.q[a as usize].total_cmp(&im.w.q[b as usize]))
+        .unwrap();
+    let plan = im.plan_deletion(worst).expect("a deletion");
+    let made = im.apply_deletion(plan);
+    assert_eq!((made.len(), im.stats.deletions), (1, 1));
+    let out = im.w.to_mesh();
+    assert_eq!(out.vertices, mesh.vertices[..4].to_vec());
+    assert_eq!(out.tets.len(), 1);
+    assert!(min_q(&out) > 0.3, "{} -> {}", before, min_q(&out));
+    assert!((vol(&out) - vol(&mesh)).abs() <= 1e-12 * vol(&mesh));
+    assert_eq!(out.tet_regions, vec![7]);
+    check_no_degenerate(&out).unwrap();
+}

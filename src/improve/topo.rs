@@ -40,6 +40,8 @@ pub(crate) struct Work {
     pub q: Vec<f64>,
     /// The objective's radius-edge weight.
     pub rho_weight: f64,
+    /// Vertices deletion removed (no tet uses them; the output drops them).
+    pub deleted: Vec<u32>,
 }
 
 /// Face `i` of tet `tv` (the one opposite its vertex `i`).
@@ -94,6 +96,7 @@ impl Work {
             flat_edges: FxHashSet::default(),
             q: Vec::with_capacity(mesh.tets.len()),
             rho_weight,
+            deleted: vec![],
         };
         let mut degree = vec![0u32; n];
         mesh.tets
@@ -268,17 +271,30 @@ impl Work {
         (out, n)
     }
 
-    /// Back to a `TetMesh`: alive tets in slot order, boundary triangles in their order.
+    /// Back to a `TetMesh`: alive tets in slot order, boundary triangles in their order. The
+    /// deleted vertices are dropped (later ones move down; the input's vertices, which are
+    /// never deleted and come first, keep their ids).
     pub fn to_mesh(&self) -> TetMesh {
+        let mut new_id: Vec<u32> = (0..self.pos.len() as u32).collect();
+        let mut gone = vec![false; self.pos.len()];
+        self.deleted.iter().for_each(|&v| gone[v as usize] = true);
+        let mut vertices = Vec::with_capacity(self.pos.len() - self.deleted.len());
+        for (v, &p) in self.pos.iter().enumerate() {
+            new_id[v] = vertices.len() as u32;
+            if !gone[v] {
+                vertices.push(p);
+            }
+        }
+        let map3 = |f: &[u32; 3]| f.map(|v| new_id[v as usize]);
         let mut m = TetMesh {
-            vertices: self.pos.clone(),
-            boundary: self.btri.clone(),
+            vertices,
+            boundary: self.btri.iter().map(map3).collect(),
             boundary_markers: self.bmarker.clone(),
             ..Default::default()
         };
         for (i, t) in self.tets.iter().enumerate() {
             if self.alive[i] {
-                m.tets.push(*t);
+                m.tets.push(t.map(|v| new_id[v as usize]));
                 m.tet_regions.push(self.region[i]);
             }
         }

@@ -110,13 +110,14 @@ impl Report {
         row(
             "time improvement (s)",
             format!(
-                "{:.3} (flips {}, moves {}, insertions {}{})",
+                "{:.3} (flips {}, moves {}, insertions {}, deletions {}{})",
                 self.seconds_improvement,
                 self.improvement.edge_removals
                     + self.improvement.face_removals
                     + self.improvement.boundary_flips,
                 self.improvement.smoothed,
                 self.improvement.insertions,
+                self.improvement.deletions,
                 if self.delaunay { ", Delaunay" } else { "" }
             ),
         );
