@@ -91,6 +91,10 @@ struct Restricted {
 /// A face of the triangulation: a tet and the local index of the vertex opposite the face.
 type FaceRef = (u32, usize);
 
+/// A surface centre closer than this fraction of its facet's radius to a vertex is not
+/// inserted (see `insert_surface_point`).
+const EMPTY_BALL_FRACTION: f64 = 0.5;
+
 /// Why a restricted facet is refined.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Bad {
@@ -689,6 +693,13 @@ impl<'a> SurfaceMesher<'a> {
         if let crate::delaunay::Probe::Duplicate(_) = self.dt.probe(r.centre, Some(hint)) {
             return;
         }
+        // A restricted facet's surface ball is empty. A vertex well inside it means the facet
+        // was judged on ill-conditioned circumcentres (nearly flat tets of coplanar samples),
+        // and its centre may sit on that vertex: two vertices 1e-16 apart, a zero-angle facet
+        // and a cascade (star.off at sizes 0.05-0.3). Such a centre is not inserted.
+        if self.nearest_in_probe(r.centre) < EMPTY_BALL_FRACTION * r.radius {
+            return;
+        }
         let encroached = self.encroached_by_probe(r.centre);
         if !encroached.is_empty() {
             // A centre on a feature curve encroaches its subsegments at every scale: after
@@ -715,6 +726,17 @@ impl<'a> SurfaceMesher<'a> {
             .push(Loc::Patch(self.patch_of[r.triangle as usize]));
         debug_assert_eq!(self.loc.len(), id as usize + 1);
         self.after_insertion();
+    }
+
+    /// Distance from `p` to the nearest vertex of the probed cavity (its nearest vertex).
+    fn nearest_in_probe(&self, p: DVec3) -> f64 {
+        let (cavity, _) = self.dt.probed_cavity();
+        cavity
+            .iter()
+            .flat_map(|&t| self.dt.tet(t))
+            .filter(|&v| v != INFINITE)
+            .map(|v| self.dt.point(v).distance(p))
+            .fold(f64::INFINITY, f64::min)
     }
 
     /// Subsegments (splittable, outside small corners' balls) among the probed cavity's edges
