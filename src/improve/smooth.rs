@@ -66,6 +66,27 @@ impl Improver<'_> {
             .fold(f64::INFINITY, f64::min)
     }
 
+    /// The worst objective of v's star with v at x if it beats `floor`, else `None`, found
+    /// with the tets in `order` (indices into `star`; the worst ones first, so that a failing
+    /// trial stops early). The value is `star_min`'s whenever it is returned.
+    fn star_min_above(
+        &self,
+        star: &[[u32; 4]],
+        order: &[usize],
+        v: u32,
+        x: DVec3,
+        floor: f64,
+    ) -> Option<f64> {
+        let mut worst = f64::INFINITY;
+        for &k in order {
+            worst = worst.min(q_at(&self.w.pos, self.w.rho_weight, &star[k], v, x));
+            if worst <= floor {
+                return None;
+            }
+        }
+        Some(worst)
+    }
+
     /// The non-smooth ascent of the worst objective of `star` (tets holding vertex `v`, which
     /// starts at `x0` with worst objective `q0`) within constraint `cons`: the position
     /// reached and its worst objective. Only the positions of the other vertices are read,
@@ -97,8 +118,8 @@ impl Improver<'_> {
 
         // A first guess: the centroid of the neighbours (within the constraint).
         let guess = x0 + cons.project(centroid / count - x0);
-        let qg = self.star_min(star, v, guess);
-        if qg > qx + MIN_GAIN {
+        let mut order: Vec<usize> = (0..star.len()).collect();
+        if let Some(qg) = self.star_min_above(star, &order, v, guess, qx + MIN_GAIN) {
             x = guess;
             qx = qg;
         }
@@ -110,6 +131,7 @@ impl Improver<'_> {
                 .map(|t| q_at(&self.w.pos, self.w.rho_weight, t, v, x))
                 .collect();
             let worst = qs.iter().copied().fold(f64::INFINITY, f64::min);
+            order.sort_by(|&a, &b| qs[a].total_cmp(&qs[b]));
             let mut grads = vec![];
             for (t, &q) in star.iter().zip(&qs) {
                 if q > worst + ACTIVE || grads.len() >= 6 {
@@ -133,8 +155,7 @@ impl Improver<'_> {
             let mut moved = false;
             for _ in 0..10 {
                 let y = x + dir * step;
-                let qy = self.star_min(star, v, y);
-                if qy > qx + MIN_GAIN {
+                if let Some(qy) = self.star_min_above(star, &order, v, y, qx + MIN_GAIN) {
                     x = y;
                     qx = qy;
                     moved = true;
