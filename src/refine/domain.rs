@@ -67,6 +67,9 @@ pub struct Domain {
     pub dirty_tris: Vec<[u32; 3]>,
     /// Tets created by insertions since the refiner last looked (it classifies them).
     pub created_log: Vec<u32>,
+    /// Whether a boundary vertex (segment or facet) was inserted since the refiner last looked:
+    /// only then can a cavity have crossed a subfacet (`retag_created`).
+    pub boundary_inserted: bool,
 }
 
 /// Input angles below this (between segments at a vertex, or between facets at a segment) are
@@ -161,6 +164,7 @@ impl Domain {
             dirty_segs: vec![],
             dirty_tris: vec![],
             created_log: vec![],
+            boundary_inserted: false,
         })
     }
 
@@ -358,6 +362,7 @@ impl Domain {
                 self.near_small_angle.push(near);
                 self.queue_around_last_insertion();
                 self.created_log.extend_from_slice(self.dt.last_created());
+                self.boundary_inserted |= kind != VertexKind::Volume;
                 Ok(id)
             }
             Ok(Inserted::Duplicate(v)) => Err(MeshError::Internal(format!(

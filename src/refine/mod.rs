@@ -534,6 +534,7 @@ fn refine_passes(
     let mut on_step = |n: usize| progress((n as f64 / max_v).min(1.0), n);
     for _ in 0..2 {
         dom.created_log.clear();
+        dom.boundary_inserted = false;
         let mut r = quality::Refiner::new(dom, ctx.params, ctx.spacing, regions);
         r.run(&mut on_step)?;
         out.stop_reason = r.stop_reason.take();

@@ -236,7 +236,11 @@ impl<'a> Refiner<'a> {
     /// Queues the bad tets among those created since the last call.
     fn push_recent(&mut self) -> Result<(), MeshError> {
         let recent = std::mem::take(&mut self.dom.created_log);
-        self.dom.retag_created(&recent);
+        // A volume point's cavity never holds a subfacet (the refiner splits what it would
+        // encroach instead), so its tets inherit the right region.
+        if std::mem::take(&mut self.dom.boundary_inserted) {
+            self.dom.retag_created(&recent);
+        }
         self.push_tets(&recent)
     }
 
