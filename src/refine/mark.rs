@@ -8,6 +8,7 @@ use super::MeshError;
 use crate::delaunay::{tables::FACE, INFINITE};
 use crate::plc::PlcInput;
 use crate::union_find::UnionFind;
+use rustc_hash::FxHashMap;
 
 /// Region attribute and size limit of each component tag (index 0 = outside, unused).
 #[derive(Debug, Clone, Default)]
@@ -98,7 +99,7 @@ impl Domain {
     /// exterior tets labelled inside on the curved models) until the next whole re-marking.
     /// A group whose old neighbours disagree keeps its tags. Returns the tets re-tagged.
     pub fn retag_created(&mut self, created: &[u32]) -> usize {
-        let mut index: rustc_hash::FxHashMap<u32, u32> = rustc_hash::FxHashMap::default();
+        let mut index: FxHashMap<u32, u32> = FxHashMap::default();
         let mut tets = Vec::with_capacity(created.len());
         for &t in created {
             if self.dt.is_alive(t) && !index.contains_key(&t) {
@@ -117,7 +118,7 @@ impl Domain {
             }
         }
         // Per group root: the tag its old neighbours agree on (None: they disagree).
-        let mut tag_of: rustc_hash::FxHashMap<u32, Option<u32>> = Default::default();
+        let mut tag_of: FxHashMap<u32, Option<u32>> = FxHashMap::default();
         for (i, &t) in tets.iter().enumerate() {
             let v = self.dt.tet(t);
             for (k, n) in self.dt.neighbors(t).into_iter().enumerate() {
