@@ -311,8 +311,9 @@ impl Improver<'_> {
 
 impl Improver<'_> {
     /// Tries the best flip touching tet `t` (vertices `tv`), else smoothing of its vertices,
-    /// else an insertion around it or the deletion of one of its vertices, whichever is better. Returns the tets made or moved (empty: nothing changed
-    /// them) and whether a vertex was skipped for its per-pass smoothing cap.
+    /// else an insertion around it or the deletion of one of its vertices, whichever is
+    /// better. Returns the tets made or moved (empty: nothing changed them) and whether a
+    /// vertex was skipped for its per-pass smoothing cap.
     fn work_on(
         &mut self,
         t: u32,
