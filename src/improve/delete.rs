@@ -40,10 +40,7 @@ impl Improver<'_> {
             if !matches!(self.cons[v as usize], Constraint::Free) || star.len() > MAX_STAR {
                 continue;
             }
-            let old = star
-                .iter()
-                .map(|&s| w.q[s as usize])
-                .fold(f64::INFINITY, f64::min);
+            let old = w.worst_q(star);
             let mut link: Vec<u32> = star
                 .iter()
                 .flat_map(|&s| w.tets[s as usize])
@@ -91,15 +88,21 @@ impl Improver<'_> {
         })
     }
 
+    /// Records vertex `v`, which no tet uses any more, as deleted: nothing moves it again and
+    /// the output drops it.
+    pub(crate) fn forget_vertex(&mut self, v: u32) {
+        self.cons[v as usize] = Constraint::Fixed;
+        self.w.deleted.push(v);
+        self.stats.deletions += 1;
+    }
+
     /// Carries a deletion out; returns the new tets. The vertex keeps its slot, unused (the
     /// output drops it).
     pub(crate) fn apply_deletion(&mut self, plan: Deletion) -> Vec<u32> {
         for &t in &plan.kill {
             self.w.kill_tet(t);
         }
-        self.cons[plan.v as usize] = Constraint::Fixed;
-        self.w.deleted.push(plan.v);
-        self.stats.deletions += 1;
+        self.forget_vertex(plan.v);
         plan.make
             .iter()
             .map(|&(t, region)| self.w.add_tet(t, region))

@@ -40,11 +40,7 @@ pub(crate) enum Kind {
 fn old_min(w: &Work, tets: &[u32]) -> (f64, Option<i32>) {
     let r = w.region[tets[0] as usize];
     let same = tets.iter().all(|&t| w.region[t as usize] == r);
-    let m = tets
-        .iter()
-        .map(|&t| w.q[t as usize])
-        .fold(f64::INFINITY, f64::min);
-    (m, same.then_some(r))
+    (w.worst_q(tets), same.then_some(r))
 }
 
 /// The smallest gain that counts (keeps rounding noise from cycling).

@@ -54,10 +54,7 @@ impl Improver<'_> {
         let mut best: Option<Insertion> = None;
         for _ in 0..MAX_GROWTH {
             let (make, from) = self.cone(&cavity, region);
-            let old = cavity
-                .iter()
-                .map(|&c| w.q[c as usize])
-                .fold(f64::INFINITY, f64::min);
+            let old = w.worst_q(&cavity);
             let q0 = self.star_min(&make, NEW, x);
             let (at, new_min) = self.ascend(&make, NEW, x, q0, Constraint::Free);
             x = at;
@@ -172,9 +169,7 @@ impl Improver<'_> {
             .collect();
         for u in old {
             if self.w.star[u as usize].is_empty() {
-                self.cons[u as usize] = Constraint::Fixed;
-                self.w.deleted.push(u);
-                self.stats.deletions += 1;
+                self.forget_vertex(u);
             }
         }
         made

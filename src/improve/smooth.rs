@@ -187,10 +187,7 @@ impl Improver<'_> {
         }
         let star: Vec<[u32; 4]> = ids.iter().map(|&t| self.w.tets[t as usize]).collect();
         let x0 = self.w.p(v);
-        let q0 = ids
-            .iter()
-            .map(|&t| self.w.q[t as usize])
-            .fold(f64::INFINITY, f64::min);
+        let q0 = self.w.worst_q(&ids);
         let (mut x, mut qx) = self.ascend(&star, v, x0, q0, cons);
         if let Some(s) = self.sliding(v) {
             // Back onto the input surface, where the move is judged.

@@ -123,6 +123,13 @@ impl Work {
         self.pos[v as usize]
     }
 
+    /// The least objective of tets `tets`.
+    pub fn worst_q(&self, tets: &[u32]) -> f64 {
+        tets.iter()
+            .map(|&t| self.q[t as usize])
+            .fold(f64::INFINITY, f64::min)
+    }
+
     pub fn points(&self, t: &[u32; 4]) -> [DVec3; 4] {
         t.map(|v| self.pos[v as usize])
     }

@@ -148,7 +148,9 @@ impl Domain {
         changed
     }
 
-    /// Whether face f (three vertex ids) is a subfacet.
+    /// Whether face f (three vertex ids) is a subfacet. Only a face whose three vertices lie
+    /// on the boundary can be one: that is tested before the hash lookup (most faces have a
+    /// volume vertex).
     fn is_subfacet(&self, f: [u32; 3]) -> bool {
         !f.contains(&INFINITE)
             && f.iter()
@@ -161,14 +163,6 @@ impl Domain {
     /// component, whether it touches the hull.
     fn components(&self) -> (Vec<u32>, Vec<bool>) {
         let cap = self.dt.tet_capacity();
-        // Only a face whose three vertices lie on the boundary can be a subfacet: test that
-        // before the hash lookup (most faces have a volume vertex).
-        let on_boundary: Vec<bool> = self.kind.iter().map(|&k| k != VertexKind::Volume).collect();
-        let is_subfacet = |f: [u32; 3]| {
-            !f.contains(&INFINITE)
-                && f.iter().all(|&x| on_boundary[x as usize])
-                && self.subfacets.contains_key(&tri_key(f))
-        };
         // Union-find over the faces that are not subfacets, scanning the tets in memory order
         // (a flood fill would visit them in a cache-hostile order). Each face once: from the
         // tet with the smaller id.
@@ -179,7 +173,7 @@ impl Domain {
             }
             let v = self.dt.tet(t);
             for (i, n) in self.dt.neighbors(t).into_iter().enumerate() {
-                if n > t && !is_subfacet(FACE[i].map(|k| v[k])) {
+                if n > t && !self.is_subfacet(FACE[i].map(|k| v[k])) {
                     uf.union(t, n);
                 }
             }
