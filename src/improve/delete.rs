@@ -11,7 +11,6 @@
 
 use super::constraints::Constraint;
 use super::flips::MIN_GAIN;
-use super::quality::objective;
 use super::Improver;
 
 /// Largest star tried (a contraction evaluates every tet of it per neighbour).
@@ -71,7 +70,7 @@ impl Improver<'_> {
             }
             let nt = tv.map(|x| if x == v { u } else { x });
             let [a, b, c, d] = w.points(&nt);
-            new_min = new_min.min(objective(a, b, c, d, w.rho_weight));
+            new_min = new_min.min(w.objective.of(a, b, c, d));
             if new_min <= floor + MIN_GAIN {
                 return None;
             }

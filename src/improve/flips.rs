@@ -1,19 +1,21 @@
 //! Topological transformations: edge removal (Shewchuk's dynamic programming over the ring
 //! of the edge; the 3-2 and 4-4 flips are its rings of 3 and 4), the same over an open ring
 //! whose two end faces are coplanar triangles of one facet patch (the boundary 2-2 flip, with
-//! a flat tet on the facet as its ring of one), and face removal (the 2-3 flip).
+//! a flat tet on the facet as its ring of one), and face removal (the 2-3 flip, and the
+//! multi-face removal that generalises it).
 //!
 //! A change is planned first and applied only when every new tet is positively oriented by
 //! the exact `orient3d` and the worst objective of the new tets beats that of the old ones.
 //! Positive orientation of all new tets is sufficient: they have the same outer faces as the
 //! old ones, so (a degree argument) they tile the same polyhedron.
 
-use super::quality::objective;
 use super::topo::{edge_key, face, key3, Work, DEAD};
 use super::Improver;
 
 /// Longest ring edge removal considers (the table is O(n^3)).
 const MAX_RING: usize = 12;
+/// Most faces a multi-face removal takes out.
+const MAX_SANDWICH: usize = 8;
 
 /// A planned change, applied by [`Improver::apply`].
 pub(crate) struct Plan {
@@ -34,6 +36,7 @@ pub(crate) enum Kind {
     EdgeRemoval,
     BoundaryFlip,
     FaceRemoval,
+    MultiFaceRemoval,
 }
 
 /// The least of the old tets' objectives, and whether they all share one region.
@@ -51,7 +54,7 @@ impl Improver<'_> {
     /// only made for tets that could help).
     fn candidate(&self, t: [u32; 4], floor: f64) -> f64 {
         let [a, b, c, d] = self.w.points(&t);
-        let q = objective(a, b, c, d, self.w.rho_weight);
+        let q = self.w.objective.of(a, b, c, d);
         if q <= floor || !self.w.positive(t) {
             return f64::NEG_INFINITY;
         }
@@ -212,9 +215,13 @@ impl Improver<'_> {
         Some(vec![(t1, orient([p, q, a])), (t2, orient([p, q, b]))])
     }
 
-    /// The 2-3 flip of interior face f: its two tets become three around the edge joining
-    /// their apexes.
-    pub(crate) fn plan_face(&self, f: [u32; 3]) -> Option<Plan> {
+    /// Face removal from interior face f, whose two tets have apexes d and e: the faces
+    /// sandwiched between d and e (f, then faces joined to it across an edge, each the base of
+    /// a tet with apex d and one with apex e) are removed and the tets they bound become tets
+    /// around the new edge de, one per edge of the sandwich's outline. One face is the 2-3
+    /// flip; more is Klingner & Shewchuk's multi-face removal. The sandwich grows greedily
+    /// across the outline edge of the worst new tet; the best stage is kept.
+    pub(crate) fn plan_faces(&self, f: [u32; 3]) -> Option<Plan> {
         let w = &self.w;
         if w.is_boundary_face(f) {
             return None;
@@ -223,8 +230,7 @@ impl Improver<'_> {
         if n != 2 {
             return None;
         }
-        let (old, region) = old_min(w, &pair);
-        let region = region?;
+        let region = old_min(w, &pair).1?;
         let apex = |t: u32| w.tets[t as usize].into_iter().find(|v| !f.contains(v));
         let (d, e) = (apex(pair[0])?, apex(pair[1])?);
         let [mut a, mut b, c] = f;
@@ -232,24 +238,98 @@ impl Improver<'_> {
         if !super::topo::even_perm(&t1, [a, b, c, d]) {
             std::mem::swap(&mut a, &mut b);
         }
-        let floor = old + MIN_GAIN;
-        let make = vec![[a, b, e, d], [b, c, e, d], [c, a, e, d]];
-        let mut new_min = f64::INFINITY;
-        for &t in &make {
-            new_min = new_min.min(self.candidate(t, floor));
-            if new_min <= floor {
-                return None;
+        // The outline, directed so that (x, y, e, d) is the new tet of edge (x, y).
+        let mut outline = vec![(a, b), (b, c), (c, a)];
+        // Float objectives while growing; the exact orientation test is made for a stage
+        // about to be kept.
+        let q_of = |t: [u32; 4]| {
+            let [p, q, r, s] = w.points(&t);
+            w.objective.of(p, q, r, s)
+        };
+        let mut q: Vec<f64> = outline.iter().map(|&(x, y)| q_of([x, y, e, d])).collect();
+        let mut kill = pair.to_vec();
+        let mut best: Option<Plan> = None;
+        loop {
+            let new_min = q.iter().copied().fold(f64::INFINITY, f64::min);
+            if new_min > w.worst_q(&kill) + MIN_GAIN
+                && best.as_ref().is_none_or(|b| new_min > b.new_min)
+                && outline.iter().all(|&(x, y)| w.positive([x, y, e, d]))
+            {
+                best = Some(Plan {
+                    new_min,
+                    kill: kill.clone(),
+                    make: outline.iter().map(|&(x, y)| [x, y, e, d]).collect(),
+                    region,
+                    boundary: vec![],
+                    diagonal: None,
+                    kind: if kill.len() == 2 {
+                        Kind::FaceRemoval
+                    } else {
+                        Kind::MultiFaceRemoval
+                    },
+                });
             }
+            if kill.len() >= 2 * MAX_SANDWICH {
+                break;
+            }
+            let mut order: Vec<usize> = (0..outline.len()).collect();
+            order.sort_by(|&i, &j| q[i].total_cmp(&q[j]).then(i.cmp(&j)));
+            let Some((k, v, tets)) = order.iter().find_map(|&k| {
+                let (x, y) = outline[k];
+                self.sandwiched(x, y, d, e, region, &kill)
+                    .filter(|&(v, _)| outline.iter().all(|&(p, _)| p != v))
+                    .map(|(v, tets)| (k, v, tets))
+            }) else {
+                break;
+            };
+            let (x, y) = outline[k];
+            outline.splice(k..=k, [(x, v), (v, y)]);
+            q.splice(k..=k, [q_of([x, v, e, d]), q_of([v, y, e, d])]);
+            kill.extend(tets);
         }
-        Some(Plan {
-            new_min,
-            kill: pair.to_vec(),
-            make,
-            region,
-            boundary: vec![],
-            diagonal: None,
-            kind: Kind::FaceRemoval,
-        })
+        best
+    }
+
+    /// The face (x, y, v) beyond outline edge (x, y) of a sandwich between d and e, if it is
+    /// sandwiched too: an interior face whose two tets, both of `region` and not yet in
+    /// `kill`, have apexes d and e. Returns v and those two tets.
+    fn sandwiched(
+        &self,
+        x: u32,
+        y: u32,
+        d: u32,
+        e: u32,
+        region: i32,
+        kill: &[u32],
+    ) -> Option<(u32, [u32; 2])> {
+        let w = &self.w;
+        let fd = [x, y, d];
+        if w.is_boundary_face(fd) {
+            return None;
+        }
+        let (pair, n) = w.face_tets(fd);
+        let td = *pair.iter().find(|t| !kill.contains(t))?;
+        if n != 2 || w.region[td as usize] != region {
+            return None;
+        }
+        let v = w.tets[td as usize]
+            .into_iter()
+            .find(|&u| u != x && u != y && u != d)?;
+        let g = [x, y, v];
+        if v == e || w.is_boundary_face(g) || w.is_boundary_face([x, y, e]) {
+            return None;
+        }
+        let (pair, n) = w.face_tets(g);
+        let te = if pair[0] == td { pair[1] } else { pair[0] };
+        if n != 2
+            || te == DEAD
+            || kill.contains(&te)
+            || w.region[te as usize] != region
+            || !w.tets[te as usize].contains(&e)
+        {
+            return None;
+        }
+        Some((v, [td, te]))
     }
 
     /// Carries a plan out; returns the new tets.
@@ -274,6 +354,7 @@ impl Improver<'_> {
             Kind::EdgeRemoval => self.stats.edge_removals += 1,
             Kind::BoundaryFlip => self.stats.boundary_flips += 1,
             Kind::FaceRemoval => self.stats.face_removals += 1,
+            Kind::MultiFaceRemoval => self.stats.multi_face_removals += 1,
         }
         made
     }
@@ -295,7 +376,7 @@ impl Improver<'_> {
             }
         }
         for i in 0..4 {
-            consider(self.plan_face(face(tv, i)));
+            consider(self.plan_faces(face(tv, i)));
         }
         best
     }

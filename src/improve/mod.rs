@@ -2,13 +2,14 @@
 //! improvement", IMR 2007): on the final [`TetMesh`], with no knowledge of how it was made.
 //!
 //! - `quality`: the objective, the smallest sine of the dihedral angles (small for angles near
-//!   0 and near 180 degrees alike), capped so that a radius-edge ratio over the bound scores
-//!   as badly as an angle under the target;
+//!   0 and near 180 degrees alike; below the target a large angle counts more than a small
+//!   one), capped so that a radius-edge ratio over the bound scores as badly as an angle
+//!   under the target;
 //! - `topo`: the working mesh (tet slots, vertex stars, boundary triangles, edge rings);
 //! - `constraints`: how each vertex may move (input vertices never, segment vertices along the
 //!   segment, facet vertices in the facet's plane), and the flat facet patches;
 //! - `flips`: edge removal (3-2, 4-4 and larger rings by dynamic programming), the boundary 2-2
-//!   flip inside one facet patch, face removal (2-3);
+//!   flip inside one facet patch, face removal (2-3) and multi-face removal;
 //! - `smooth`: non-smooth optimisation of the worst objective of a vertex's star;
 //! - `insert`: a new vertex joined to the outer faces of a cavity around the tet, placed by
 //!   the same optimisation.
@@ -69,6 +70,8 @@ impl Default for Options {
 pub struct Stats {
     pub edge_removals: usize,
     pub face_removals: usize,
+    /// Face removals that took out more than one face.
+    pub multi_face_removals: usize,
     pub boundary_flips: usize,
     pub smoothed: usize,
     /// Vertices inserted where flips and smoothing left a tet bad.
@@ -92,6 +95,7 @@ impl Stats {
     pub fn changed(&self) -> bool {
         self.edge_removals
             + self.face_removals
+            + self.multi_face_removals
             + self.boundary_flips
             + self.smoothed
             + self.insertions
@@ -164,8 +168,8 @@ pub fn improve_with(
     slide: Option<&dyn SurfaceSlide>,
 ) -> (TetMesh, Stats) {
     let start = std::time::Instant::now();
-    let rho_weight = opts.target_deg.to_radians().sin() * opts.max_rho;
-    let mut w = Work::new(mesh, rho_weight);
+    let objective = quality::Objective::new(opts.target_deg, opts.max_rho);
+    let mut w = Work::new(mesh, objective);
     let (mut cons, normals) = constraints::classify(&mut w, input);
     if let Some(s) = slide {
         constraints::let_slide(&w, &mut cons, s);

@@ -10,7 +10,7 @@
 
 use super::constraints::{on_hull, Constraint};
 use super::flips::MIN_GAIN;
-use super::quality::objective;
+use super::quality::Objective;
 use super::topo::DEAD;
 use super::Improver;
 use glam::DVec3;
@@ -24,9 +24,9 @@ const ACTIVE: f64 = 1e-3;
 
 /// The objective of star tet `t` (vertex ids) with vertex `v` at `x`.
 #[inline]
-fn q_at(pos: &[DVec3], rho_weight: f64, t: &[u32; 4], v: u32, x: DVec3) -> f64 {
+fn q_at(pos: &[DVec3], objective: Objective, t: &[u32; 4], v: u32, x: DVec3) -> f64 {
     let p = t.map(|u| if u == v { x } else { pos[u as usize] });
-    objective(p[0], p[1], p[2], p[3], rho_weight)
+    objective.of(p[0], p[1], p[2], p[3])
 }
 
 /// The point of least norm in the convex hull of `g` (Frank-Wolfe; exact for two points).
@@ -62,7 +62,7 @@ impl Improver<'_> {
     /// Worst objective of v's star with v at x.
     pub(crate) fn star_min(&self, star: &[[u32; 4]], v: u32, x: DVec3) -> f64 {
         star.iter()
-            .map(|t| q_at(&self.w.pos, self.w.rho_weight, t, v, x))
+            .map(|t| q_at(&self.w.pos, self.w.objective, t, v, x))
             .fold(f64::INFINITY, f64::min)
     }
 
@@ -79,7 +79,7 @@ impl Improver<'_> {
     ) -> Option<f64> {
         let mut worst = f64::INFINITY;
         for &k in order {
-            worst = worst.min(q_at(&self.w.pos, self.w.rho_weight, &star[k], v, x));
+            worst = worst.min(q_at(&self.w.pos, self.w.objective, &star[k], v, x));
             if worst <= floor {
                 return None;
             }
@@ -128,7 +128,7 @@ impl Improver<'_> {
         for _ in 0..MAX_STEPS {
             let qs: Vec<f64> = star
                 .iter()
-                .map(|t| q_at(&self.w.pos, self.w.rho_weight, t, v, x))
+                .map(|t| q_at(&self.w.pos, self.w.objective, t, v, x))
                 .collect();
             let worst = qs.iter().copied().fold(f64::INFINITY, f64::min);
             order.sort_by(|&a, &b| qs[a].total_cmp(&qs[b]));
@@ -138,9 +138,9 @@ impl Improver<'_> {
                     continue;
                 }
                 let g = DVec3::new(
-                    q_at(&self.w.pos, self.w.rho_weight, t, v, x + DVec3::X * h) - q,
-                    q_at(&self.w.pos, self.w.rho_weight, t, v, x + DVec3::Y * h) - q,
-                    q_at(&self.w.pos, self.w.rho_weight, t, v, x + DVec3::Z * h) - q,
+                    q_at(&self.w.pos, self.w.objective, t, v, x + DVec3::X * h) - q,
+                    q_at(&self.w.pos, self.w.objective, t, v, x + DVec3::Y * h) - q,
+                    q_at(&self.w.pos, self.w.objective, t, v, x + DVec3::Z * h) - q,
                 ) / h;
                 grads.push(cons.project(g));
             }
@@ -202,7 +202,7 @@ impl Improver<'_> {
         }
         self.w.pos[v as usize] = x;
         for (&t, tv) in ids.iter().zip(&star) {
-            self.w.q[t as usize] = q_at(&self.w.pos, self.w.rho_weight, tv, v, x);
+            self.w.q[t as usize] = q_at(&self.w.pos, self.w.objective, tv, v, x);
         }
         self.stats.smoothed += 1;
         true

@@ -68,6 +68,58 @@ fn three_two_flip_removes_a_long_edge() {
     check_no_degenerate(&out).unwrap();
 }
 
+/// Two apexes over a fan of three faces (a flat pentagonal bipyramid): removing faces of the
+/// fan at once makes tets around the axis.
+#[test]
+fn multi_face_removal_takes_out_a_fan_of_faces() {
+    let (d, e) = (DVec3::new(0.0, 0.0, 0.25), DVec3::new(0.0, 0.0, -0.25));
+    let mut vertices = vec![d, e];
+    vertices.extend((0..5).map(|k| {
+        let t = k as f64 * std::f64::consts::TAU / 5.0;
+        DVec3::new(t.cos(), t.sin(), 0.0)
+    }));
+    let mut tets = vec![];
+    for [x, y, z] in [[2, 3, 4], [2, 4, 5], [2, 5, 6]] {
+        tets.push(positively_oriented([0, x, y, z], &vertices));
+        tets.push(positively_oriented([1, x, y, z], &vertices));
+    }
+    let mesh = TetMesh {
+        vertices,
+        tets,
+        tet_regions: vec![1; 6],
+        ..Default::default()
+    };
+    let before = min_q(&mesh);
+    let mut im = improver_for(&mesh);
+    // The axis de misses face (r0, r1, r2): its 2-3 flip would make an inverted tet. The
+    // removal grows over the next face(s) of the fan.
+    let plan = im.plan_faces([2, 3, 4]).expect("face removal improves");
+    assert!(plan.new_min > before + 0.1, "{before} -> {}", plan.new_min);
+    im.apply(plan);
+    assert_eq!(im.stats.multi_face_removals, 1, "{:?}", im.stats);
+    let out = im.w.to_mesh();
+    let around_de = out
+        .tets
+        .iter()
+        .filter(|t| t.contains(&0) && t.contains(&1))
+        .count();
+    assert!(around_de >= 4, "{:?}", out.tets);
+    assert!(min_q(&out) >= before);
+    assert!((vol(&out) - vol(&mesh)).abs() <= 1e-12 * vol(&mesh));
+    check_no_degenerate(&out).unwrap();
+}
+
+/// An improver on `mesh` with every vertex fixed, for planning changes directly.
+fn improver_for(mesh: &TetMesh) -> Improver<'static> {
+    Improver {
+        w: Work::new(mesh, quality::Objective::new(26.0, f64::INFINITY)),
+        cons: vec![Constraint::Fixed; mesh.vertices.len()],
+        normals: vec![],
+        slide: None,
+        stats: Stats::default(),
+    }
+}
+
 /// A flat tet (four coplanar points) gets reported with its vertices and coordinates.
 #[test]
 fn degenerate_tet_is_named() {
@@ -310,23 +362,13 @@ fn two_three_flip() {
             t.swap(0, 1);
         }
     }
-    let w = Work::new(
-        &TetMesh {
-            vertices,
-            tets,
-            tet_regions: vec![0, 0],
-            ..Default::default()
-        },
-        f64::INFINITY,
-    );
-    let im = Improver {
-        w,
-        cons: vec![Constraint::Fixed; 5],
-        normals: vec![],
-        slide: None,
-        stats: Stats::default(),
-    };
-    let plan = im.plan_face([0, 1, 2]).expect("2-3 flip improves");
+    let im = improver_for(&TetMesh {
+        vertices,
+        tets,
+        tet_regions: vec![0, 0],
+        ..Default::default()
+    });
+    let plan = im.plan_faces([0, 1, 2]).expect("2-3 flip improves");
     assert!(plan.new_min > im.w.q[0].max(im.w.q[1]));
 }
 
@@ -354,7 +396,7 @@ fn insertion_lifts_a_flat_tet_off_a_fold() {
     };
     let before = min_q(&mesh);
     assert!(before < 1e-2);
-    let mut w = topo::Work::new(&mesh, f64::INFINITY);
+    let mut w = topo::Work::new(&mesh, quality::Objective::new(26.0, f64::INFINITY));
     let (cons, normals) = constraints::classify(&mut w, None);
     let mut im = Improver {
         w,
@@ -401,7 +443,7 @@ fn deletion_removes_a_vertex_squeezed_against_a_face() {
     };
     let before = min_q(&mesh);
     assert!(before < 1e-2);
-    let mut w = topo::Work::new(&mesh, f64::INFINITY);
+    let mut w = topo::Work::new(&mesh, quality::Objective::new(26.0, f64::INFINITY));
     let (cons, normals) = constraints::classify(&mut w, None);
     assert!(matches!(cons[4], Constraint::Free) && matches!(cons[0], Constraint::Fixed));
     let mut im = Improver {

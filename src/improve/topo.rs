@@ -1,7 +1,7 @@
 //! The improver's working mesh: tets in slots (a free list keeps ids stable and reuse
 //! deterministic), vertex stars, boundary triangles by sorted key, and the rings around edges.
 
-use super::quality::objective;
+use super::quality::Objective;
 use crate::geom::orient3d;
 use crate::mesh::TetMesh;
 use glam::DVec3;
@@ -36,10 +36,9 @@ pub(crate) struct Work {
     /// Boundary edges (sorted pair, smaller id high) inside one facet patch: the only ones a
     /// boundary flip may remove.
     pub flat_edges: FxHashSet<u64>,
-    /// Objective (`quality::objective`) of every tet slot.
+    /// Objective of every tet slot.
     pub q: Vec<f64>,
-    /// The objective's radius-edge weight.
-    pub rho_weight: f64,
+    pub objective: Objective,
     /// Vertices deletion removed (no tet uses them; the output drops them).
     pub deleted: Vec<u32>,
 }
@@ -79,7 +78,7 @@ pub(crate) fn even_perm(t: &[u32; 4], p: [u32; 4]) -> bool {
 }
 
 impl Work {
-    pub fn new(mesh: &TetMesh, rho_weight: f64) -> Work {
+    pub fn new(mesh: &TetMesh, objective: Objective) -> Work {
         let n = mesh.vertices.len();
         let mut w = Work {
             pos: mesh.vertices.clone(),
@@ -95,7 +94,7 @@ impl Work {
             bstar: vec![Vec::new(); n],
             flat_edges: FxHashSet::default(),
             q: Vec::with_capacity(mesh.tets.len()),
-            rho_weight,
+            objective,
             deleted: vec![],
         };
         let mut degree = vec![0u32; n];
@@ -136,7 +135,7 @@ impl Work {
 
     pub fn add_tet(&mut self, t: [u32; 4], region: i32) -> u32 {
         let [a, b, c, d] = self.points(&t);
-        let q = objective(a, b, c, d, self.rho_weight);
+        let q = self.objective.of(a, b, c, d);
         let id = match self.free.pop() {
             Some(id) => {
                 self.tets[id as usize] = t;

@@ -114,6 +114,7 @@ impl Report {
                 self.seconds_improvement,
                 self.improvement.edge_removals
                     + self.improvement.face_removals
+                    + self.improvement.multi_face_removals
                     + self.improvement.boundary_flips,
                 self.improvement.smoothed,
                 self.improvement.insertions,
