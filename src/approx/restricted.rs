@@ -26,7 +26,7 @@ pub use volume::VolumeCriteria;
 
 use super::curves::{Curve, FeatureCurves};
 use crate::delaunay::tables::FACE;
-use crate::delaunay::{Delaunay, Inserted, INFINITE};
+use crate::delaunay::{Cavity, Delaunay, Inserted, Probe, INFINITE};
 use crate::geom::{circumcenter, tri_circumcenter};
 use crate::refine::{MeshError, Spacing};
 use crate::surface::oracle::{Crossing, SurfaceOracle};
@@ -690,17 +690,17 @@ impl<'a> SurfaceMesher<'a> {
         if why != Bad::Boundary && self.near_small_corner(r.centre) {
             return;
         }
-        if let crate::delaunay::Probe::Duplicate(_) = self.dt.probe(r.centre, Some(hint)) {
+        let Probe::Cavity(cavity) = self.dt.probe(r.centre, Some(hint)) else {
             return;
-        }
+        };
         // A restricted facet's surface ball is empty. A vertex well inside it means the facet
         // was judged on ill-conditioned circumcentres (nearly flat tets of coplanar samples),
         // and its centre may sit on that vertex: two vertices 1e-16 apart, a zero-angle facet
         // and a cascade (star.off at sizes 0.05-0.3). Such a centre is not inserted.
-        if self.nearest_in_probe(r.centre) < EMPTY_BALL_FRACTION * r.radius {
+        if self.nearest_in_cavity(&cavity) < EMPTY_BALL_FRACTION * r.radius {
             return;
         }
-        let encroached = self.encroached_by_probe(r.centre);
+        let encroached = self.encroached_by_cavity(&cavity);
         if !encroached.is_empty() {
             // A centre on a feature curve encroaches its subsegments at every scale: after
             // MAX_DEFERRALS rounds of splits the facet is left as it is.
@@ -719,7 +719,7 @@ impl<'a> SurfaceMesher<'a> {
             });
             return;
         }
-        let Ok(Inserted::New(id)) = self.dt.insert(r.centre, Some(hint)) else {
+        let Ok(Inserted::New(id)) = self.dt.insert_cavity(cavity) else {
             return;
         };
         self.loc
@@ -728,10 +728,11 @@ impl<'a> SurfaceMesher<'a> {
         self.after_insertion();
     }
 
-    /// Distance from `p` to the nearest vertex of the probed cavity (its nearest vertex).
-    fn nearest_in_probe(&self, p: DVec3) -> f64 {
-        let (cavity, _) = self.dt.probed_cavity();
-        cavity
+    /// Distance from the probed point to the nearest vertex of its cavity (its nearest vertex).
+    fn nearest_in_cavity(&self, cavity: &Cavity) -> f64 {
+        let p = cavity.point();
+        let (removed, _) = self.dt.cavity(cavity);
+        removed
             .iter()
             .flat_map(|&t| self.dt.tet(t))
             .filter(|&v| v != INFINITE)
@@ -740,11 +741,12 @@ impl<'a> SurfaceMesher<'a> {
     }
 
     /// Subsegments (splittable, outside small corners' balls) among the probed cavity's edges
-    /// whose diametric ball holds `p`.
-    fn encroached_by_probe(&self, p: DVec3) -> Vec<[u32; 2]> {
-        let (cavity, _) = self.dt.probed_cavity();
+    /// whose diametric ball holds the probed point.
+    fn encroached_by_cavity(&self, cavity: &Cavity) -> Vec<[u32; 2]> {
+        let p = cavity.point();
+        let (removed, _) = self.dt.cavity(cavity);
         let mut out = vec![];
-        for &t in cavity {
+        for &t in removed {
             let tv = self.dt.tet(t);
             let on_curve = tv.map(|v| self.on_curve(v));
             for i in 0..4 {

@@ -7,7 +7,7 @@
 //! conflicting tets around the tet containing p; its boundary is star-shaped from p.
 
 use super::tables::FACE;
-use super::{has_infinite, Delaunay, Inserted, Tet, DEAD, INFINITE};
+use super::{has_infinite, Delaunay, DelaunayError, Inserted, Tet, DEAD, INFINITE};
 use crate::geom::{insphere, insphere_tie, orient3d, InsphereFan};
 use glam::DVec3;
 
@@ -28,9 +28,9 @@ pub(super) struct Scratch {
     tags: Vec<u32>,
     /// Directed boundary edge -> face reference of the new tet that owns it.
     edges: EdgeTable,
-    /// The point whose cavity `cavity` and `boundary` hold, when they were computed by a
-    /// probe ([`Delaunay::probe`]) and the triangulation has not changed since: inserting
-    /// exactly this point then reuses them.
+    /// The point whose probe ([`Delaunay::probe`]) filled `cavity` and `boundary`; cleared by
+    /// any other search or edit. Only a [`Cavity`] token for this point (and the current
+    /// generation) reads or inserts them.
     probed: Option<DVec3>,
 }
 
@@ -76,12 +76,34 @@ impl BoundaryFace {
 }
 
 /// What a probe found (see [`Delaunay::probe`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug)]
 pub enum Probe {
     /// The point equals this vertex.
     Duplicate(u32),
-    /// The cavity is available from [`Delaunay::probed_cavity`].
-    Cavity,
+    /// The point's cavity: read it with [`Delaunay::cavity`], insert the point with
+    /// [`Delaunay::insert_cavity`].
+    Cavity(Cavity),
+}
+
+/// A claim on the cavity a probe computed (held in the triangulation's one set of buffers):
+/// current until the triangulation changes or a different point is probed, either of which
+/// overwrites them ([`Delaunay::is_current`]). Neither `Clone` nor `Copy`: inserting consumes
+/// it.
+#[derive(Debug)]
+pub struct Cavity {
+    p: DVec3,
+    /// The probe's hint, for locating `p` afresh once the token is stale.
+    hint: Option<u32>,
+    /// [`Delaunay`]'s edit counter at the probe.
+    generation: u64,
+}
+
+impl Cavity {
+    /// The probed point.
+    #[inline]
+    pub fn point(&self) -> DVec3 {
+        self.p
+    }
 }
 
 /// Cavity search marks (zero: not visited).
@@ -117,27 +139,14 @@ impl Delaunay {
         Inserted::New(id)
     }
 
-    /// Inserts the new vertex `id` (the last id) at the point of the last probe, whose cavity
-    /// is still in the scratch buffers; false (nothing done) if there is none for that point.
-    pub(super) fn insert_probed(&mut self, id: u32) -> bool {
-        debug_assert_eq!(id as usize + 1, self.points.len());
-        if self.scratch.probed != Some(self.points[id as usize]) {
-            return false;
-        }
-        // The probe ranked the would-be vertex as `points.len()` before the push: `id`.
-        self.fill_cavity(id);
-        self.n_vertices += 1;
-        true
-    }
-
     /// The tets a new point at `p` would remove and the faces it would connect to, without
     /// changing the triangulation. `hint` is a tet to start the walk from (any alive tet).
-    /// Allocates; [`Self::probe`] and [`Self::probed_cavity`] do the same in place.
+    /// Allocates; [`Self::probe`] and [`Self::cavity`] do the same in place.
     pub fn dry_run(&mut self, p: DVec3, hint: Option<u32>) -> DryRun {
         match self.probe(p, hint) {
             Probe::Duplicate(v) => DryRun::Duplicate(v),
-            Probe::Cavity => {
-                let (removed, faces) = self.probed_cavity();
+            Probe::Cavity(c) => {
+                let (removed, faces) = self.cavity(&c);
                 DryRun::Cavity {
                     removed: removed.to_vec(),
                     faces: faces.iter().map(|f| f.v).collect(),
@@ -147,12 +156,12 @@ impl Delaunay {
     }
 
     /// Computes the cavity a new point at `p` would have, without changing the triangulation
-    /// (refinement tests candidate points with this); read it with [`Self::probed_cavity`].
-    /// `hint` is a tet to start the walk from (any alive tet). Until the next probe or change,
-    /// [`Self::insert`] of exactly `p` reuses this cavity instead of searching again.
+    /// (refinement tests candidate points with this). `hint` is a tet to start the walk from
+    /// (any alive tet). The cavity goes into the triangulation's one set of buffers, so a
+    /// probe makes every earlier token stale unless it is of the same point.
     pub fn probe(&mut self, p: DVec3, hint: Option<u32>) -> Probe {
-        let hint = hint.filter(|&t| self.is_alive(t)).unwrap_or(self.last);
-        let start = self.locate(p, hint);
+        let start = hint.filter(|&t| self.is_alive(t)).unwrap_or(self.last);
+        let start = self.locate(p, start);
         if let Some(dup) = self.coincident_vertex(start, p) {
             self.scratch.probed = None;
             return Probe::Duplicate(dup);
@@ -160,17 +169,45 @@ impl Delaunay {
         // The would-be vertex ranks above every existing one, as a real insertion would.
         self.find_cavity(p, self.points.len() as u32, start);
         self.scratch.probed = Some(p);
-        Probe::Cavity
+        Probe::Cavity(Cavity {
+            p,
+            hint,
+            generation: self.generation,
+        })
     }
 
-    /// The cavity of the last [`Self::probe`] that found one: the tets inserting the point
-    /// would delete, and the cavity's boundary faces (one new tet each). Empty when the
-    /// triangulation changed since.
-    pub fn probed_cavity(&self) -> (&[u32], &[BoundaryFace]) {
-        if self.scratch.probed.is_none() {
+    /// Whether the buffers still hold `cavity`'s cavity: no edit since its probe, and the last
+    /// probe was of the same point.
+    #[inline]
+    pub fn is_current(&self, cavity: &Cavity) -> bool {
+        self.generation == cavity.generation && self.scratch.probed == Some(cavity.p)
+    }
+
+    /// The probed cavity: the tets inserting the point would delete, and the cavity's
+    /// boundary faces (one new tet each). A stale token is a bug: it panics in debug builds
+    /// and reads an empty cavity in release builds.
+    pub fn cavity(&self, cavity: &Cavity) -> (&[u32], &[BoundaryFace]) {
+        let current = self.is_current(cavity);
+        debug_assert!(current, "stale cavity token");
+        if !current {
             return (&[], &[]);
         }
         (&self.scratch.cavity, &self.scratch.boundary)
+    }
+
+    /// Inserts the probed point, with its cavity when the token is current, else (the
+    /// triangulation changed, or another point was probed since) searching afresh from the
+    /// probe's hint like [`Self::insert`].
+    pub fn insert_cavity(&mut self, cavity: Cavity) -> Result<Inserted, DelaunayError> {
+        if !self.is_current(&cavity) {
+            return self.insert(cavity.p, cavity.hint);
+        }
+        let id = self.push_vertex(cavity.p)?;
+        // The probe ranked the would-be vertex `points.len()` before the push: `id`. (No
+        // vertex came since: an insertion edits, and a duplicate one is popped again.)
+        self.fill_cavity(id);
+        self.n_vertices += 1;
+        Ok(Inserted::New(id))
     }
 
     fn coincident_vertex(&self, t: u32, p: DVec3) -> Option<u32> {
@@ -407,6 +444,7 @@ impl Delaunay {
     fn fill_cavity(&mut self, id: u32) {
         let mut s = std::mem::take(&mut self.scratch);
         s.probed = None;
+        self.generation += 1;
         // Remember the deleted tets (refinement re-checks the boundary elements they held).
         s.removed.clear();
         for &t in &s.cavity {

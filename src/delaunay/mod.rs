@@ -19,7 +19,7 @@ pub mod tables;
 mod validate;
 
 use crate::geom::{self, orient3d};
-pub use cavity::{BoundaryFace, DryRun, Probe};
+pub use cavity::{BoundaryFace, Cavity, DryRun, Probe};
 use glam::DVec3;
 use tables::FACE;
 
@@ -113,6 +113,10 @@ pub struct Delaunay {
     /// Hint for the next location: the last tet created.
     last: u32,
     rng: u32,
+    /// Edit counter, bumped by every change to the tets (so far only `fill_cavity` makes any
+    /// after construction; whatever else edits them must bump it too): a [`Cavity`] token
+    /// from an earlier generation is stale.
+    generation: u64,
     scratch: cavity::Scratch,
 }
 
@@ -166,7 +170,24 @@ impl Delaunay {
 
     /// Inserts one point, locating it from `hint` (a tet id) or from the last insertion.
     /// A duplicate of an existing vertex changes nothing and consumes no id.
+    /// It always searches: [`Self::insert_cavity`] saves the search for a probed point.
     pub fn insert(&mut self, p: DVec3, hint: Option<u32>) -> Result<Inserted, DelaunayError> {
+        let id = self.push_vertex(p)?;
+        let hint = match hint.filter(|&t| self.is_alive(t)) {
+            Some(t) => t,
+            None => self.hint_towards(p),
+        };
+        let r = self.insert_vertex(id, hint);
+        if let Inserted::Duplicate(_) = r {
+            self.points.pop();
+            self.vertex_tet.pop();
+            self.rank.pop();
+        }
+        Ok(r)
+    }
+
+    /// Appends `p` as the next vertex id (ranked by it), not yet in the triangulation.
+    fn push_vertex(&mut self, p: DVec3) -> Result<u32, DelaunayError> {
         if self.n_alive == 0 {
             return Err(DelaunayError::Empty);
         }
@@ -179,20 +200,7 @@ impl Delaunay {
         self.points.push(p);
         self.vertex_tet.push(NO_TET);
         self.rank.push(index as u32);
-        if self.insert_probed(index as u32) {
-            return Ok(Inserted::New(index as u32));
-        }
-        let hint = match hint.filter(|&t| self.is_alive(t)) {
-            Some(t) => t,
-            None => self.hint_towards(p),
-        };
-        let r = self.insert_vertex(index as u32, hint);
-        if let Inserted::Duplicate(_) = r {
-            self.points.pop();
-            self.vertex_tet.pop();
-            self.rank.pop();
-        }
-        Ok(r)
+        Ok(index as u32)
     }
 
     /// Number of vertex ids handed out (including skipped duplicates).

@@ -1,5 +1,5 @@
 //! Kernel tests: validity on uniform, clustered, grid, sphere and coplanar-start inputs, counts
-//! against an independent brute-force Delaunay, dry runs, duplicates and errors.
+//! against an independent brute-force Delaunay, dry runs, probes, duplicates and errors.
 
 use super::*;
 use crate::geom::insphere;
@@ -339,44 +339,102 @@ fn tags_are_inherited_through_cavities() {
     dt.validate().unwrap();
 }
 
+/// Finite tets as sorted vertex quadruples, sorted (independent of tet ids and orientation).
+fn sorted_tets(dt: &Delaunay) -> Vec<[u32; 4]> {
+    let mut t: Vec<[u32; 4]> = dt
+        .finite_tets()
+        .map(|mut t| {
+            t.sort_unstable();
+            t
+        })
+        .collect();
+    t.sort_unstable();
+    t
+}
+
+fn probed(dt: &mut Delaunay, p: DVec3) -> Cavity {
+    match dt.probe(p, None) {
+        Probe::Cavity(c) => c,
+        Probe::Duplicate(v) => panic!("{p} is vertex {v}"),
+    }
+}
+
 #[test]
-fn insertion_reuses_only_the_cavity_of_the_same_point() {
+fn inserting_a_probed_cavity_matches_plain_insertion() {
     let pts = uniform(2000, 13);
     let (mut dt, _) = Delaunay::from_points(&pts).unwrap();
     let mut reference = dt.clone();
     let new = uniform(200, 14);
     for (k, pair) in new.chunks(2).enumerate() {
         let (p, q) = (pair[0], pair[1]);
-        // Probe p then q; insert p (the scratch holds q's cavity: no reuse), then probe and
-        // insert q (reuse); or, every other round, insert q right after its probe.
-        assert_eq!(dt.probe(p, None), Probe::Cavity);
-        assert_eq!(dt.probe(q, None), Probe::Cavity);
-        let (removed, faces) = dt.probed_cavity();
+        let cp = probed(&mut dt, p);
+        let cq = probed(&mut dt, q);
+        // One set of buffers: probing q made p's token stale.
+        assert!(!dt.is_current(&cp) && dt.is_current(&cq));
+        let (removed, faces) = dt.cavity(&cq);
         assert!(!removed.is_empty() && !faces.is_empty());
-        let order = if k % 2 == 0 { [p, q] } else { [q, p] };
-        for x in order {
-            if x == p && k % 2 == 0 {
-                dt.probe(x, None);
-            }
-            dt.insert(x, None).unwrap();
-            reference.insert(x, None).unwrap();
-            // After a change, no probed cavity is offered.
-            assert!(dt.probed_cavity().0.is_empty());
+        let n = dt.num_vertex_ids() as u32;
+        if k % 2 == 0 {
+            // Both stale when inserted: fresh searches.
+            assert_eq!(dt.insert_cavity(cp), Ok(Inserted::New(n)));
+            assert!(!dt.is_current(&cq));
+            assert_eq!(dt.insert_cavity(cq), Ok(Inserted::New(n + 1)));
+            reference.insert(p, None).unwrap();
+            reference.insert(q, None).unwrap();
+        } else {
+            // Both current when inserted: the probed cavities are used.
+            assert_eq!(dt.insert_cavity(cq), Ok(Inserted::New(n)));
+            let cp = probed(&mut dt, p);
+            assert_eq!(dt.insert_cavity(cp), Ok(Inserted::New(n + 1)));
+            reference.insert(q, None).unwrap();
+            reference.insert(p, None).unwrap();
         }
+        assert_eq!(dt.num_vertices(), reference.num_vertices());
     }
     dt.validate().unwrap();
-    let sorted = |dt: &Delaunay| {
-        let mut t: Vec<[u32; 4]> = dt
-            .finite_tets()
-            .map(|mut t| {
-                t.sort_unstable();
-                t
-            })
-            .collect();
-        t.sort_unstable();
-        t
-    };
-    assert_eq!(sorted(&dt), sorted(&reference));
+    assert_eq!(sorted_tets(&dt), sorted_tets(&reference));
+}
+
+#[test]
+fn a_cavity_token_is_stale_after_an_insertion() {
+    let pts = uniform(1000, 15);
+    let (mut dt, _) = Delaunay::from_points(&pts).unwrap();
+    let mut reference = dt.clone();
+    let [p, q] = [DVec3::new(0.31, 0.52, 0.47), DVec3::new(0.7, 0.2, 0.6)];
+    let cp = probed(&mut dt, p);
+    dt.insert(q, None).unwrap();
+    assert!(!dt.is_current(&cp));
+    // Reading it is a bug: loud in debug builds, an empty cavity in release builds.
+    let read = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| dt.cavity(&cp).0.len()));
+    if cfg!(debug_assertions) {
+        assert!(read.is_err());
+    } else {
+        assert_eq!(read.ok(), Some(0));
+    }
+    // Inserting it searches afresh.
+    let n = dt.num_vertex_ids() as u32;
+    assert_eq!(dt.insert_cavity(cp), Ok(Inserted::New(n)));
+    assert_eq!(dt.point(n), p);
+    reference.insert(q, None).unwrap();
+    reference.insert(p, None).unwrap();
+    dt.validate().unwrap();
+    assert_eq!(sorted_tets(&dt), sorted_tets(&reference));
+}
+
+#[test]
+fn a_probe_of_a_vertex_is_a_duplicate() {
+    let pts = uniform(500, 16);
+    let (mut dt, _) = Delaunay::from_points(&pts).unwrap();
+    let cavity = probed(&mut dt, DVec3::splat(0.5));
+    for (v, &p) in pts.iter().enumerate().step_by(50) {
+        let Probe::Duplicate(d) = dt.probe(p, None) else {
+            panic!("vertex {v} not found");
+        };
+        assert_eq!(dt.point(d), p);
+    }
+    // A duplicate probe leaves no cavity: earlier tokens are stale.
+    assert!(!dt.is_current(&cavity));
+    assert_eq!(dt.num_vertex_ids(), 500);
 }
 
 #[test]

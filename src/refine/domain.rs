@@ -4,7 +4,7 @@
 
 use super::MeshError;
 use crate::cdt::{Change, FacetMesh};
-use crate::delaunay::{Delaunay, Inserted};
+use crate::delaunay::{Cavity, Delaunay, Inserted};
 use crate::plc::PlcInput;
 use glam::DVec3;
 use rustc_hash::{FxHashMap, FxHashSet};
@@ -346,14 +346,20 @@ impl Domain {
         self.dt.point(v)
     }
 
-    /// Inserts a new vertex into the 3D triangulation.
+    /// Inserts a new vertex into the 3D triangulation, located from `hint`, or with
+    /// `probed`'s cavity when that is a current probe of `p`.
     pub fn insert_point(
         &mut self,
         p: DVec3,
         kind: VertexKind,
         hint: Option<u32>,
+        probed: Option<Cavity>,
     ) -> Result<u32, MeshError> {
-        match self.dt.insert(p, hint) {
+        let inserted = match probed {
+            Some(c) if c.point() == p && self.dt.is_current(&c) => self.dt.insert_cavity(c),
+            _ => self.dt.insert(p, hint),
+        };
+        match inserted {
             Ok(Inserted::New(id)) => {
                 let apex = self.apex_of(p, kind);
                 self.kind.push(kind);
@@ -405,9 +411,16 @@ impl Domain {
         o + (q - o) * t
     }
 
-    /// Splits subsegment ab at `p`: inserts the vertex and updates subsegments and every facet
-    /// holding the segment. Returns the new vertex.
-    pub fn split_subsegment(&mut self, a: u32, b: u32, p: DVec3) -> Result<u32, MeshError> {
+    /// Splits subsegment ab at `p` (`probed`: its probe, see [`Self::insert_point`]): inserts
+    /// the vertex and updates subsegments and every facet holding the segment. Returns the new
+    /// vertex.
+    pub fn split_subsegment(
+        &mut self,
+        a: u32,
+        b: u32,
+        p: DVec3,
+        probed: Option<Cavity>,
+    ) -> Result<u32, MeshError> {
         let key = seg_key(a, b);
         let seg = *self
             .subsegs
@@ -415,7 +428,8 @@ impl Domain {
             .ok_or_else(|| MeshError::Internal(format!("({a}, {b}) is not a subsegment")))?;
         let p = self.splittable_point(seg, a, b, p);
         let hint = self.dt.vertex_tet(a);
-        let id = self.insert_point(p, VertexKind::Segment(seg), hint)?;
+        // `p` may have moved: then `probed` is not of it.
+        let id = self.insert_point(p, VertexKind::Segment(seg), hint, probed)?;
         self.subsegs.remove(&key);
         for half in [seg_key(a, id), seg_key(id, b)] {
             self.subsegs.insert(half, seg);
@@ -457,12 +471,14 @@ impl Domain {
         p
     }
 
-    /// Inserts `p` (inside facet `f`) into the 3D triangulation and the facet's triangulation.
+    /// Inserts `p` (inside facet `f`) into the 3D triangulation and the facet's triangulation
+    /// (`probed`: its probe, see [`Self::insert_point`]).
     pub fn split_in_facet(
         &mut self,
         f: u32,
         p: DVec3,
         hint: Option<u32>,
+        probed: Option<Cavity>,
     ) -> Result<u32, MeshError> {
         // Checked before the 3D insertion so that a refusal leaves both triangulations as
         // they were.
@@ -472,7 +488,7 @@ impl Domain {
                 p.x, p.y, p.z
             ))
         })?;
-        let id = self.insert_point(p, VertexKind::Facet(f), hint)?;
+        let id = self.insert_point(p, VertexKind::Facet(f), hint, probed)?;
         let change = self.facets[f as usize].insert(id, p).map_err(|e| {
             MeshError::Internal(format!(
                 "facet {f}: point ({}, {}, {}) not inserted: {e:?}",

@@ -9,7 +9,7 @@
 use super::domain::{seg_key, tri_key, Domain, VertexKind};
 use super::mark::Regions;
 use super::{MeshError, Params, Spacing};
-use crate::delaunay::{tables::FACE, BoundaryFace, Probe, INFINITE};
+use crate::delaunay::{tables::FACE, BoundaryFace, Cavity, Probe, INFINITE};
 use crate::geom::screen::{
     longest_edge_direct as longest_edge, shortest_edge_sq, sliver_measures, SliverScreen,
 };
@@ -366,44 +366,45 @@ impl<'a> Refiner<'a> {
                 return self.resettle_or_give_up(bad.tet);
             }
         }
-        let centre_breaks = self.encroached_boundary(centre, Some(bad.tet));
+        let (centre_cavity, centre_breaks) = self.encroached_boundary(centre, Some(bad.tet));
         if near {
-            // An empty probed cavity: the centre is a vertex already.
-            if centre_breaks.is_some() || self.dom.dt.probed_cavity().1.is_empty() {
-                return self.leave_near_small_angle(bad);
-            }
-            // The insertion reuses the centre's probed cavity.
-            return self.insert_volume_vertex(centre, bad.tet);
+            // No cavity: the centre is a vertex already.
+            return match (centre_breaks, centre_cavity) {
+                (None, Some(cavity)) => self.insert_volume_vertex(centre, bad.tet, Some(cavity)),
+                _ => self.leave_near_small_angle(bad),
+            };
         }
         if let Some(bnd) = centre_breaks {
             return self.refine_encroached(bad, bnd, r);
         }
-        self.insert_from_picking_ball(bad, centre, r)
+        self.insert_from_picking_ball(bad, centre, r, centre_cavity)
     }
 
     /// Inserts the best point of bad tet `bad`'s picking ball (centre `centre`, circumradius
-    /// `r`, which breaks no boundary: the caller checked, and probed its cavity last).
+    /// `r`, which breaks no boundary: the caller checked, with the probe `centre_cavity`,
+    /// None if the centre is a vertex).
     fn insert_from_picking_ball(
         &mut self,
         bad: Bad,
         centre: DVec3,
         r: f64,
+        centre_cavity: Option<Cavity>,
     ) -> Result<(), MeshError> {
         // Draw candidates from the picking ball; keep the one with fewest small slivers among
         // those that break no boundary.
         let mut best = None;
         // The centre is a point of the picking ball too, and its cavity is at hand (probed by
         // the boundary check above, which it passed): the first candidate.
-        if !self.dom.dt.probed_cavity().1.is_empty() {
-            if let Some((n_small, worst)) = self.small_slivers(centre, r, None) {
+        if let Some(cavity) = centre_cavity {
+            if let Some((n_small, worst)) = self.small_slivers(&cavity, r, None) {
                 best = Some(Candidate {
                     n_small,
                     worst,
-                    p: centre,
+                    cavity,
                 });
             }
         }
-        if best.is_none_or(|b| b.n_small > 0) {
+        if best.as_ref().is_none_or(|b| b.n_small > 0) {
             for _ in 0..self.params.max_tries.max(1) {
                 let p = centre + self.random_in_ball() * (self.params.delta * r);
                 if self.try_candidate(p, r, Some(bad.tet), None, &mut best) {
@@ -413,17 +414,24 @@ impl<'a> Refiner<'a> {
         }
         // The chosen point breaks no boundary: a candidate was only kept after that check on
         // its cavity, and the centre passed it above (nothing has changed since). When it was
-        // the last one probed (the usual case: its draw ended the search), the insertion
-        // reuses its cavity.
-        let p = best.map_or(centre, |b| b.p);
-        self.insert_volume_vertex(p, bad.tet)
+        // the last one probed (the usual case: its draw ended the search), its cavity is
+        // still current and the insertion reuses it.
+        match best {
+            Some(b) => self.insert_volume_vertex(b.cavity.point(), bad.tet, Some(b.cavity)),
+            None => self.insert_volume_vertex(centre, bad.tet, None),
+        }
     }
 
-    /// Inserts volume vertex `p` (located from tet `hint`; a cavity probed last for exactly
-    /// `p` is reused), restores empty encroachment around it and queues the new bad tets.
-    fn insert_volume_vertex(&mut self, p: DVec3, hint: u32) -> Result<(), MeshError> {
+    /// Inserts volume vertex `p` (located from tet `hint`, or with `cavity`, a probe of `p`,
+    /// while current), restores empty encroachment around it and queues the new bad tets.
+    fn insert_volume_vertex(
+        &mut self,
+        p: DVec3,
+        hint: u32,
+        cavity: Option<Cavity>,
+    ) -> Result<(), MeshError> {
         self.dom
-            .insert_point(p, super::domain::VertexKind::Volume, Some(hint))?;
+            .insert_point(p, super::domain::VertexKind::Volume, Some(hint), cavity)?;
         self.settle_boundary()?;
         self.push_recent()
     }
@@ -463,11 +471,11 @@ impl<'a> Refiner<'a> {
     /// Inserts `p` (for size-bad tet `t` of size `r`) unless it would break the boundary; then
     /// the boundary element is split instead if it is not much smaller than `r`, else nothing.
     fn insert_volume_point(&mut self, p: DVec3, r: f64, t: u32) -> Result<(), MeshError> {
-        if let Probe::Duplicate(_) = self.dom.dt.probe(p, Some(t)) {
+        let Probe::Cavity(cavity) = self.dom.dt.probe(p, Some(t)) else {
             self.gave_up += 1; // p is a vertex already (a flat tet's centroid can be)
             return Ok(());
-        }
-        if let Some(bnd) = self.boundary_in_cavity(p) {
+        };
+        if let Some(bnd) = self.boundary_in_cavity(&cavity) {
             // Only size refinement comes here: the boundary element is split even next to a
             // small angle (such splits stop once the elements are a fraction of f, unlike
             // splits for shape, which can go on without end).
@@ -481,7 +489,7 @@ impl<'a> Refiner<'a> {
             self.gave_up += 1;
             return Ok(());
         }
-        self.insert_volume_vertex(p, t)
+        self.insert_volume_vertex(p, t, Some(cavity))
     }
 
     /// Leaves bad tet `bad` as it is: it is within a small input angle's influence.
@@ -499,7 +507,7 @@ impl<'a> Refiner<'a> {
     /// creates fewer small slivers (circumradius <= b r, sigma < sigma0 or a small dihedral
     /// angle; ties: the larger smallest dihedral angle) and breaks no boundary (except the
     /// element being split, `allowed`). Returns true when `p` creates no small sliver (the
-    /// search can stop; `p` is then the last point probed).
+    /// search can stop; `best`'s cavity is then current).
     fn try_candidate(
         &mut self,
         p: DVec3,
@@ -508,30 +516,39 @@ impl<'a> Refiner<'a> {
         allowed: Option<Boundary>,
         best: &mut Option<Candidate>,
     ) -> bool {
-        if let Probe::Duplicate(_) = self.dom.dt.probe(p, hint) {
+        let Probe::Cavity(cavity) = self.dom.dt.probe(p, hint) else {
             return false;
-        }
-        let Some((n_small, worst)) = self.small_slivers(p, r, best.map(|b| b.n_small)) else {
+        };
+        let limit = best.as_ref().map(|b| b.n_small);
+        let Some((n_small, worst)) = self.small_slivers(&cavity, r, limit) else {
             return false; // more small slivers than the best
         };
-        if best.is_some_and(|b| (n_small, -worst) >= (b.n_small, -b.worst)) {
+        if best
+            .as_ref()
+            .is_some_and(|b| (n_small, -worst) >= (b.n_small, -b.worst))
+        {
             return false; // not better: whether it breaks the boundary does not matter
         }
-        if allowed.is_none() && self.boundary_in_cavity(p).is_some() {
+        if allowed.is_none() && self.boundary_in_cavity(&cavity).is_some() {
             return false; // p would break the boundary
         }
-        *best = Some(Candidate { n_small, worst, p });
+        *best = Some(Candidate {
+            n_small,
+            worst,
+            cavity,
+        });
         n_small == 0
     }
 
     /// Small slivers (circumradius <= b R, sigma < sigma0 or a small dihedral angle) inserting
-    /// `p` would create, with the probed cavity of `p`, and the smallest 1 - cos(smallest
-    /// dihedral angle) among them; None as soon as there are more than `limit`.
-    fn small_slivers(&self, p: DVec3, r: f64, limit: Option<usize>) -> Option<(usize, f64)> {
+    /// the probed point would create, and the smallest 1 - cos(smallest dihedral angle) among
+    /// them; None as soon as there are more than `limit`.
+    fn small_slivers(&self, cavity: &Cavity, r: f64, limit: Option<usize>) -> Option<(usize, f64)> {
         let mut n = 0;
         let mut worst = f64::INFINITY;
         let max_r = self.params.b * r;
-        let faces = self.dom.dt.probed_cavity().1;
+        let p = cavity.point();
+        let faces = self.dom.dt.cavity(cavity).1;
         let points = self.dom.dt.points();
         let corners = |f: &BoundaryFace| {
             let v = f.vertices();
@@ -581,20 +598,27 @@ impl<'a> Refiner<'a> {
     /// subfacet among the cavity's edges/faces with `p` in its closed diametric/equatorial
     /// ball, or, when the cavity would cross the boundary (it holds an outside tet or would
     /// delete a subfacet), the subfacet it crosses.
-    fn encroached_boundary(&mut self, p: DVec3, hint: Option<u32>) -> Option<Boundary> {
-        if let Probe::Duplicate(_) = self.dom.dt.probe(p, hint) {
-            return None;
-        }
-        self.boundary_in_cavity(p)
+    /// Also returns `p`'s probe (None: `p` is a vertex, and breaks nothing).
+    fn encroached_boundary(
+        &mut self,
+        p: DVec3,
+        hint: Option<u32>,
+    ) -> (Option<Cavity>, Option<Boundary>) {
+        let Probe::Cavity(cavity) = self.dom.dt.probe(p, hint) else {
+            return (None, None);
+        };
+        let breaks = self.boundary_in_cavity(&cavity);
+        (Some(cavity), breaks)
     }
 
-    /// See [`Self::encroached_boundary`], for the probed cavity of `p`. Looks at the cavity
-    /// and the ring of tets around it (an equatorial ball can hold p while the (obtuse) tet on
-    /// its inner side does not have p in its circumsphere); of the encroached elements it
-    /// names the smallest subsegment (by key), else the smallest subfacet.
-    fn boundary_in_cavity(&self, p: DVec3) -> Option<Boundary> {
+    /// See [`Self::encroached_boundary`], for a probed cavity. Looks at the cavity and the
+    /// ring of tets around it (an equatorial ball can hold p while the (obtuse) tet on its
+    /// inner side does not have p in its circumsphere); of the encroached elements it names
+    /// the smallest subsegment (by key), else the smallest subfacet.
+    fn boundary_in_cavity(&self, cavity: &Cavity) -> Option<Boundary> {
         let dom = &*self.dom;
-        let (removed, faces) = dom.dt.probed_cavity();
+        let p = cavity.point();
+        let (removed, faces) = dom.dt.cavity(cavity);
         // Every vertex of a cavity tet is on the cavity's boundary, and a ring tet adds one
         // vertex to a boundary face: if no boundary face has a vertex on the domain boundary,
         // no cavity or ring tet has two, so the scan below would find no subsegment or
@@ -770,9 +794,12 @@ impl<'a> Refiner<'a> {
                             break;
                         }
                     }
-                    let p = best.map_or(cf, |c| c.p);
+                    let (p, cavity) = match best {
+                        Some(c) => (c.cavity.point(), Some(c.cavity)),
+                        None => (cf, None),
+                    };
                     let hint = self.dom.dt.vertex_tet(t[0]);
-                    self.dom.split_in_facet(f, p, hint)?;
+                    self.dom.split_in_facet(f, p, hint, cavity)?;
                 }
             }
         }
@@ -785,8 +812,8 @@ impl<'a> Refiner<'a> {
     fn split_segment_picked(&mut self, a: u32, c: u32) -> Result<(), MeshError> {
         let (pa, pc) = (self.dom.point(a), self.dom.point(c));
         let shell = self.dom.acute_vertices.contains(&a) != self.dom.acute_vertices.contains(&c);
-        let p = if shell {
-            self.dom.segment_split_point(a, c)
+        let (p, cavity) = if shell {
+            (self.dom.segment_split_point(a, c), None)
         } else {
             let r = 0.5 * pa.distance(pc);
             let mut best = None;
@@ -799,9 +826,12 @@ impl<'a> Refiner<'a> {
                     break;
                 }
             }
-            best.map_or(pa + (pc - pa) * 0.5, |c| c.p)
+            match best {
+                Some(b) => (b.cavity.point(), Some(b.cavity)),
+                None => (pa + (pc - pa) * 0.5, None),
+            }
         };
-        self.dom.split_subsegment(a, c, p)?;
+        self.dom.split_subsegment(a, c, p, cavity)?;
         Ok(())
     }
 
@@ -897,13 +927,13 @@ fn subsegment_balls(dom: &Domain, f: u32) -> Vec<SubsegmentBall> {
         .collect()
 }
 
-/// A candidate point and the small slivers inserting it would create.
-#[derive(Debug, Clone, Copy)]
+/// A candidate point (its probe) and the small slivers inserting it would create.
+#[derive(Debug)]
 struct Candidate {
     n_small: usize,
     /// Smallest 1 - cos(smallest dihedral angle) among them.
     worst: f64,
-    p: DVec3,
+    cavity: Cavity,
 }
 
 /// The boundary elements among a cavity's and its ring's edges and faces that a point
@@ -1026,7 +1056,7 @@ mod tests {
             .unwrap();
         let mid = dom.point(0).midpoint(dom.point(1));
         let p = mid + (DVec3::splat(0.5) - mid).normalize() * 0.2;
-        dom.insert_point(p, VertexKind::Volume, None).unwrap();
+        dom.insert_point(p, VertexKind::Volume, None, None).unwrap();
         dom.dirty_segs.clear();
         dom.dirty_tris.clear();
         dom.created_log.clear();
@@ -1086,7 +1116,7 @@ mod tests {
             .position(|s| s.ends.contains(&0) && s.ends.contains(&1))
             .unwrap();
         let mid = dom.segment_split_point(0, 1);
-        let m = dom.split_subsegment(0, 1, mid).unwrap();
+        let m = dom.split_subsegment(0, 1, mid, None).unwrap();
         assert_eq!(dom.kind[m as usize], VertexKind::Segment(s as u32));
         let f = dom.segments[s].facets[0];
         let in_f: Vec<u32> = dom.facets[f as usize]
@@ -1100,7 +1130,7 @@ mod tests {
         let [a, b, c] = [in_f[0], in_f[1], in_f[2]];
         assert!(!dom.flat_by_construction([a, b, c, off_f]));
         let x = dom
-            .insert_point(DVec3::splat(0.5), VertexKind::Volume, None)
+            .insert_point(DVec3::splat(0.5), VertexKind::Volume, None, None)
             .unwrap();
         assert!(!dom.flat_by_construction([0, m, x, off_f]));
     }

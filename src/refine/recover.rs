@@ -80,7 +80,7 @@ impl Domain {
                 }
                 spend(budget)?;
                 let p = self.segment_split_point(a, b);
-                self.split_subsegment(a, b, p)?;
+                self.split_subsegment(a, b, p, None)?;
                 continue;
             }
             let Some(tri) = self.dirty_tris.pop() else {
@@ -203,7 +203,7 @@ impl Domain {
                 if self.subsegs.contains_key(&(x, y)) {
                     spend(budget)?;
                     let p = self.segment_split_point(x, y);
-                    self.split_subsegment(x, y, p)?;
+                    self.split_subsegment(x, y, p, None)?;
                 }
             }
             return Ok(());
@@ -218,14 +218,14 @@ impl Domain {
         } else if let Some([x, y]) = fm.constrained_edge_towards(tri, centre) {
             spend(budget)?;
             let p = self.segment_split_point(x, y);
-            self.split_subsegment(x, y, p)?;
+            self.split_subsegment(x, y, p, None)?;
             return Ok(());
         } else {
             (a + b + c) / 3.0
         };
         spend(budget)?;
         let hint = self.dt.vertex_tet(tri[0]);
-        self.split_in_facet(f, p, hint)?;
+        self.split_in_facet(f, p, hint, None)?;
         Ok(())
     }
 

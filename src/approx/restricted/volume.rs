@@ -13,7 +13,7 @@
 
 use super::{key3, Bad, Loc, Restricted, SurfaceMesher};
 use crate::delaunay::tables::FACE;
-use crate::delaunay::{BoundaryFace, Inserted, Probe, INFINITE};
+use crate::delaunay::{BoundaryFace, Cavity, Inserted, Probe, INFINITE};
 use crate::geom::circumsphere;
 use crate::geom::screen::{shortest_edge_sq, sliver_measures, SliverScreen};
 use crate::refine::{random_in_unit_ball, AutoSpacing, Spacing};
@@ -242,18 +242,18 @@ impl SurfaceMesher<'_> {
         let Some((centre, r)) = circumsphere(a, b, c, d) else {
             return;
         };
-        if let Probe::Duplicate(_) = self.dt.probe(centre, Some(t)) {
+        let Probe::Cavity(cavity) = self.dt.probe(centre, Some(t)) else {
             return;
-        }
-        match self.encroached_by_cell_point(centre) {
+        };
+        match self.encroached_by_cell_point(&cavity) {
             Encroached::Nothing => {}
             encroached => {
                 self.refine_encroached(t, tv, encroached);
                 return;
             }
         }
-        let p = self.pick_point(t, centre, r);
-        if let Ok(Inserted::New(id)) = self.dt.insert(p, Some(t)) {
+        let cavity = self.pick_point(t, cavity, r);
+        if let Ok(Inserted::New(id)) = self.dt.insert_cavity(cavity) {
             self.loc.push(Loc::Volume);
             debug_assert_eq!(self.loc.len(), id as usize + 1);
             self.after_insertion();
@@ -288,13 +288,14 @@ impl SurfaceMesher<'_> {
         }
     }
 
-    /// What inserting the last probed point `p` would break: a restricted facet whose surface
-    /// ball holds p (the largest), else feature subsegments whose diametric ball does.
-    fn encroached_by_cell_point(&self, p: DVec3) -> Encroached {
+    /// What inserting probed point p would break: a restricted facet whose surface ball holds
+    /// p (the largest), else feature subsegments whose diametric ball does.
+    fn encroached_by_cell_point(&self, probed: &Cavity) -> Encroached {
         if self.vol.is_none() {
             return Encroached::Nothing;
         }
-        let (cavity, _) = self.dt.probed_cavity();
+        let p = probed.point();
+        let (cavity, _) = self.dt.cavity(probed);
         let on_surface =
             |v: u32| v != INFINITE && !matches!(self.loc[v as usize], Loc::Volume | Loc::Far);
         let mut best: Option<([u32; 3], f64, u32)> = None;
@@ -326,7 +327,7 @@ impl SurfaceMesher<'_> {
                 }
             }
         }
-        let segs = self.encroached_by_probe(p);
+        let segs = self.encroached_by_cavity(probed);
         if segs.is_empty() {
             Encroached::Nothing
         } else {
@@ -336,28 +337,30 @@ impl SurfaceMesher<'_> {
 
     /// Li's choice: the circumcentre if it creates no small sliver, else the point of the
     /// picking ball (radius delta r) creating the fewest, among those that break nothing.
-    /// The centre's cavity is the last probed on entry.
-    fn pick_point(&mut self, t: u32, centre: DVec3, r: f64) -> DVec3 {
+    /// Takes and returns probes (the chosen one is current when it was the last drawn).
+    fn pick_point(&mut self, t: u32, centre: Cavity, r: f64) -> Cavity {
         let Some(crit) = self.vol.as_ref().map(|v| v.crit) else {
             return centre;
         };
-        let mut best = (self.small_slivers(centre, crit.b * r, usize::MAX), centre);
-        if best.0 .0 == 0 {
+        let score = self.small_slivers(&centre, crit.b * r, usize::MAX);
+        if score.0 == 0 {
             return centre;
         }
+        let c = centre.point();
+        let mut best = (score, centre);
         for _ in 0..crit.max_tries {
-            let q = centre + self.random_in_ball() * (crit.delta * r);
-            if let Probe::Duplicate(_) = self.dt.probe(q, Some(t)) {
+            let q = c + self.random_in_ball() * (crit.delta * r);
+            let Probe::Cavity(cavity) = self.dt.probe(q, Some(t)) else {
                 continue;
-            }
-            let score = self.small_slivers(q, crit.b * r, best.0 .0);
+            };
+            let score = self.small_slivers(&cavity, crit.b * r, best.0 .0);
             if score >= best.0 {
                 continue;
             }
-            if !matches!(self.encroached_by_cell_point(q), Encroached::Nothing) {
+            if !matches!(self.encroached_by_cell_point(&cavity), Encroached::Nothing) {
                 continue;
             }
-            best = (score, q);
+            best = (score, cavity);
             if score.0 == 0 {
                 break;
             }
@@ -371,14 +374,15 @@ impl SurfaceMesher<'_> {
             .map_or(DVec3::ZERO, |vol| random_in_unit_ball(&mut vol.rng))
     }
 
-    /// The small slivers (circumradius <= `max_r`) inserting the last probed point `p` would
-    /// create, and the largest cosine of a smallest dihedral angle among them; the count stops
-    /// once it passes `enough` (the point is then no better than one already found).
-    fn small_slivers(&self, p: DVec3, max_r: f64, enough: usize) -> (usize, f64) {
+    /// The small slivers (circumradius <= `max_r`) inserting probed point p would create,
+    /// and the largest cosine of a smallest dihedral angle among them; the count stops once it
+    /// passes `enough` (the point is then no better than one already found).
+    fn small_slivers(&self, cavity: &Cavity, max_r: f64, enough: usize) -> (usize, f64) {
         let Some(vol) = self.vol.as_ref() else {
             return (0, -1.0);
         };
-        let (_, faces) = self.dt.probed_cavity();
+        let p = cavity.point();
+        let (_, faces) = self.dt.cavity(cavity);
         let points = self.dt.points();
         let corners = |f: &BoundaryFace| {
             let v = f.vertices();
