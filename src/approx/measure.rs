@@ -81,8 +81,7 @@ fn output_surface(mesh: &TetMesh) -> InputSurface {
     InputSurface::from_triangles(mesh.vertices.clone(), mesh.boundary.clone())
 }
 
-/// Largest distance from a sample of an input feature edge to the nearest output feature edge
-/// (brute force over the output's feature edges, which number a few thousand).
+/// Largest distance from a sample of an input feature edge to the nearest output feature edge.
 fn feature_distance(r: &Remeshed, positions: &[DVec3]) -> f64 {
     let segs: Vec<(DVec3, DVec3)> = r
         .feature_edges
@@ -90,16 +89,13 @@ fn feature_distance(r: &Remeshed, positions: &[DVec3]) -> f64 {
         .map(|e| e.map(|v| positions[v as usize]))
         .map(|[a, b]| (a, b))
         .collect();
+    let grid = SegmentGrid::new(&segs);
     let mut worst: f64 = 0.0;
     for e in &r.features.edges {
         let [a, b] = e.map(|v| r.surface.vertices[v as usize]);
         for k in 0..=FEATURE_EDGE_SAMPLES {
             let p = a.lerp(b, k as f64 / FEATURE_EDGE_SAMPLES as f64);
-            let d = segs
-                .iter()
-                .map(|&(u, v)| point_segment_distance(p, u, v))
-                .fold(f64::INFINITY, f64::min);
-            worst = worst.max(d);
+            worst = worst.max(grid.nearest(&segs, p));
         }
     }
     if segs.is_empty() && !r.features.edges.is_empty() {
@@ -136,4 +132,130 @@ pub fn small_corner_figures(
         }
     }
     (bad_near, max_rho_away)
+}
+
+/// Segments bucketed in a uniform grid (each in every cell its bounding box meets), for the
+/// distance from a point to the nearest of them.
+struct SegmentGrid {
+    lo: DVec3,
+    cell: f64,
+    dims: [i64; 3],
+    cells: rustc_hash::FxHashMap<[i64; 3], Vec<u32>>,
+}
+
+impl SegmentGrid {
+    fn new(segs: &[(DVec3, DVec3)]) -> SegmentGrid {
+        let (lo, hi) = segs.iter().fold(
+            (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)),
+            |(l, h), &(a, b)| (l.min(a).min(b), h.max(a).max(b)),
+        );
+        let mean = segs.iter().map(|&(a, b)| a.distance(b)).sum::<f64>() / segs.len().max(1) as f64;
+        // About two segments across a cell, and at most 128 cells along an axis.
+        let cell = (2.0 * mean)
+            .max((hi - lo).max_element() / 128.0)
+            .max(1e-300);
+        let mut grid = SegmentGrid {
+            lo,
+            cell,
+            dims: [0; 3],
+            cells: Default::default(),
+        };
+        if segs.is_empty() {
+            return grid;
+        }
+        grid.dims = grid.at(hi).map(|c| c + 1);
+        for (i, &(a, b)) in segs.iter().enumerate() {
+            let (c0, c1) = (grid.at(a.min(b)), grid.at(a.max(b)));
+            for x in c0[0]..=c1[0] {
+                for y in c0[1]..=c1[1] {
+                    for z in c0[2]..=c1[2] {
+                        grid.cells.entry([x, y, z]).or_default().push(i as u32);
+                    }
+                }
+            }
+        }
+        grid
+    }
+
+    fn at(&self, p: DVec3) -> [i64; 3] {
+        let c = ((p - self.lo) / self.cell).floor();
+        [c.x as i64, c.y as i64, c.z as i64]
+    }
+
+    /// Distance from `p` to the nearest segment (infinite when there is none): the cells in
+    /// growing shells around p's cell, until the shells searched cover the distance found.
+    fn nearest(&self, segs: &[(DVec3, DVec3)], p: DVec3) -> f64 {
+        if self.cells.is_empty() {
+            return f64::INFINITY;
+        }
+        let c = self.at(p);
+        let mut best = f64::INFINITY;
+        // Cells a point may be from the grid's box, so that the shells reach every cell.
+        let reach = (0..3)
+            .map(|k| c[k].abs().max((c[k] - self.dims[k]).abs()))
+            .max()
+            .unwrap_or(0)
+            + self.dims.iter().copied().max().unwrap_or(0);
+        for ring in 0..=reach {
+            for x in c[0] - ring..=c[0] + ring {
+                for y in c[1] - ring..=c[1] + ring {
+                    for z in c[2] - ring..=c[2] + ring {
+                        let on_shell = [x - c[0], y - c[1], z - c[2]]
+                            .iter()
+                            .any(|d| d.abs() == ring);
+                        let Some(list) = on_shell.then(|| self.cells.get(&[x, y, z])).flatten()
+                        else {
+                            continue;
+                        };
+                        for &i in list {
+                            let (a, b) = segs[i as usize];
+                            best = best.min(point_segment_distance(p, a, b));
+                        }
+                    }
+                }
+            }
+            // A segment in no cell searched lies beyond the shell: at least ring cells away.
+            if best <= ring as f64 * self.cell {
+                break;
+            }
+        }
+        best
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+
+    /// The grid's nearest distance is the brute-force minimum, bit for bit, for points near
+    /// the segments and far from them.
+    #[test]
+    fn segment_grid_matches_brute_force() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let mut p = || DVec3::new(rng.gen(), rng.gen(), rng.gen());
+        let segs: Vec<(DVec3, DVec3)> = (0..300)
+            .map(|_| {
+                let a = p();
+                (a, a + (p() - DVec3::splat(0.5)) * 0.1)
+            })
+            .collect();
+        let grid = SegmentGrid::new(&segs);
+        for k in 0..500 {
+            let q = if k % 5 == 0 {
+                p() * 6.0 - DVec3::splat(3.0)
+            } else {
+                p()
+            };
+            let brute = segs
+                .iter()
+                .map(|&(a, b)| point_segment_distance(q, a, b))
+                .fold(f64::INFINITY, f64::min);
+            assert_eq!(grid.nearest(&segs, q), brute, "{q}");
+        }
+        assert_eq!(
+            SegmentGrid::new(&[]).nearest(&[], DVec3::ZERO),
+            f64::INFINITY
+        );
+    }
 }
