@@ -34,8 +34,9 @@ pub fn merge_coplanar_facets(plc: &mut PlcInput) {
     let facets = std::mem::take(&mut plc.facets);
     let planes: Vec<Option<Plane>> = facets.iter().map(|f| Plane::of(f, verts)).collect();
 
-    // Undirected edge -> uses (facet, forward).
-    let mut edges: FxHashMap<(u32, u32), Vec<(usize, bool)>> = FxHashMap::default();
+    // (undirected edge, facet, forward) of every polygon side, sorted: the two uses of an
+    // edge are adjacent.
+    let mut uses: Vec<((u32, u32), usize, bool)> = Vec::new();
     for (fi, f) in facets.iter().enumerate() {
         if planes[fi].is_none() {
             continue;
@@ -43,20 +44,17 @@ pub fn merge_coplanar_facets(plc: &mut PlcInput) {
         let p = &f.polygons[0];
         for i in 0..p.len() {
             let (u, v) = (p[i], p[(i + 1) % p.len()]);
-            let key = (u.min(v), u.max(v));
-            edges.entry(key).or_default().push((fi, u < v));
+            uses.push(((u.min(v), u.max(v)), fi, u < v));
         }
     }
+    uses.sort_unstable();
 
     let mut uf = UnionFind::new(facets.len());
-    let mut keys: Vec<&(u32, u32)> = edges.keys().collect();
-    keys.sort_unstable();
-    for key in keys {
-        let uses = &edges[key];
-        if uses.len() != 2 {
+    for run in uses.chunk_by(|x, y| x.0 == y.0) {
+        let [(_, f, df), (_, g, dg)] = run else {
             continue;
-        }
-        let ((f, df), (g, dg)) = (uses[0], uses[1]);
+        };
+        let (f, df, g, dg) = (*f, *df, *g, *dg);
         if f == g || df == dg || uf.find(f as u32) == uf.find(g as u32) {
             continue;
         }
