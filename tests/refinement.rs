@@ -164,6 +164,28 @@ fn vertex_budget_stops_with_a_reason() {
     let (_, report) = mesh(&input, &params, Some(&ConstantSpacing(0.05)), None).unwrap();
     assert!(!report.complete);
     assert!(report.stop_reason.unwrap().contains("max_vertices"));
+    // The bad tets still queued are counted as left by the budget (no other reason on this
+    // acute-free model).
+    let r = &report.refusals;
+    assert!(r.budget > 0, "{r:?}");
+    assert_eq!(r.total, r.budget, "{r:?}");
+}
+
+/// A vertex budget too small for boundary recovery itself is a bad parameter named as such,
+/// not an internal error (there is no conforming mesh to stop with).
+#[test]
+fn vertex_budget_too_small_for_boundary_recovery_is_invalid_input() {
+    let input = read_model("off/joint.off");
+    let params = Params {
+        max_vertices: 10,
+        ..Params::default()
+    };
+    match mesh(&input, &params, None, None) {
+        Err(slivermesh::refine::MeshError::InvalidInput(m)) => {
+            assert!(m.contains("max_vertices"), "{m}")
+        }
+        r => panic!("expected InvalidInput, got {:?}", r.map(|(_, r)| r)),
+    }
 }
 
 #[test]
@@ -187,10 +209,13 @@ fn progress_callback_can_cancel() {
 /// Models with small input angles (every .off model but cube and cross): refinement
 /// terminates, the mesh conforms (Delaunay, boundary tiled per marker, enclosed volume kept),
 /// and every tet away from the small angles meets the bounds (`complete`); the report counts
-/// the ones within their influence that do not.
+/// the ones within their influence that do not, and how often refinement left a bad tet alone,
+/// per reason: the reasons add up to the total (the one counter refinement kept before the
+/// reasons were told apart, and equal to it when they were).
 #[test]
 fn acute_models_terminate_and_meet_bounds_away_from_small_angles() {
     let params = Params::default();
+    let mut seen = slivermesh::refine::Refusals::default();
     for rel in [
         "off/star.off",
         "off/oblong.off",
@@ -208,6 +233,11 @@ fn acute_models_terminate_and_meet_bounds_away_from_small_angles() {
         assert!(report.complete, "{rel}: {:?}", report.stop_reason);
         check_conforming(rel, &input, &m, None);
         assert!(report.n_acute_angles > 0, "{rel}: no acute angle reported");
+        let r = &report.refusals;
+        let sum: usize = r.counts().iter().map(|(_, n)| n).sum();
+        assert_eq!(sum, r.total, "{rel}: {r:?}");
+        assert_eq!(r.budget, 0, "{rel}: {r:?}");
+        seen.add(r);
         // Every bad tet is counted as near an acute angle.
         let bad = m
             .tets
@@ -241,6 +271,16 @@ fn acute_models_terminate_and_meet_bounds_away_from_small_angles() {
             0
         };
         assert!(flat <= allowed, "{rel}: {flat} tets of no volume");
+    }
+    // The reasons the acute models give (on every one but star, which has none, most tets
+    // are left within a small angle's influence).
+    assert!(seen.near_small_angle > seen.total / 2, "{seen:?}");
+    for (name, n) in [
+        ("flat_by_construction", seen.flat_by_construction),
+        ("far_centre", seen.far_centre),
+        ("subfacet_centre_outside", seen.subfacet_centre_outside),
+    ] {
+        assert!(n > 0, "no {name}: {seen:?}");
     }
 }
 

@@ -234,51 +234,66 @@ fn poly_edges(poly: &[u32]) -> impl Iterator<Item = (u32, u32)> + '_ {
     (0..m).map(move |i| (poly[i], poly[(i + 1) % n]))
 }
 
-impl FacetMesh {
-    /// Triangulates a facet: `outer` polygons (vertex ids into `points`, in order; a 2-vertex
-    /// polygon is a lone segment, a 1-vertex one a lone point), `holes` polygons whose inside is
-    /// removed, and TetGen-style `hole_points` whose region (bounded by polygon edges) is removed.
-    /// All polygon edges become constrained edges; vertices lying exactly on one split it.
-    /// The result is the constrained Delaunay triangulation of the region.
-    ///
-    /// Errors (with ids and coordinates in the message): an id out of range or a bad coordinate,
-    /// no outer polygon with positive area, two vertices projecting to the same point, crossing
-    /// polygon edges, a constrained edge left entirely outside the facet, an empty facet.
-    pub fn new(
-        points: &[DVec3],
-        outer: &[Vec<u32>],
-        holes: &[Vec<u32>],
-        hole_points: &[DVec3],
-    ) -> Result<FacetMesh, String> {
-        let clean = |poly: &Vec<u32>| {
-            let mut c = poly.clone();
-            c.dedup();
-            while c.len() > 1 && c.first() == c.last() {
-                c.pop();
-            }
-            c
-        };
-        let outer: Vec<Vec<u32>> = outer.iter().map(clean).filter(|p| !p.is_empty()).collect();
-        let holes: Vec<Vec<u32>> = holes.iter().map(clean).collect();
-        let (mut ids, mut seen) = (Vec::new(), FxHashMap::default());
-        let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-        for &id in outer.iter().chain(&holes).flatten() {
-            ensure!((id as usize) < points.len(), "vertex id {id} out of range");
-            let p = points[id as usize];
-            check_coordinate(p).map_err(|e| format!("vertex {id} at {p}: {e}"))?;
-            if seen.insert(id, ()).is_none() {
-                (lo, hi) = (lo.min(p), hi.max(p));
-                ids.push(id);
-            }
-        }
-        for &h in hole_points {
-            check_coordinate(h).map_err(|e| format!("hole point {h}: {e}"))?;
-        }
-        let short = holes.iter().find(|h| h.len() < 3);
-        ensure!(short.is_none(), "hole {short:?}: under 3 vertices");
+/// A polygon without repeated consecutive vertices and without a repeated first vertex at
+/// its end.
+fn clean_polygon(poly: &[u32]) -> Vec<u32> {
+    let mut c = poly.to_vec();
+    c.dedup();
+    while c.len() > 1 && c.first() == c.last() {
+        c.pop();
+    }
+    c
+}
 
-        // Normal and projection from the outer polygon with the largest area; the exact winding
-        // at its extreme vertex orders the 2D axes so that it is counter-clockwise.
+/// The distinct vertex ids of the polygons, in order of first appearance, and their bounding
+/// box, after checking every id and coordinate (hole points included) and that every hole
+/// has 3 or more vertices.
+fn checked_vertices(
+    points: &[DVec3],
+    outer: &[Vec<u32>],
+    holes: &[Vec<u32>],
+    hole_points: &[DVec3],
+) -> Result<(Vec<u32>, DVec3, DVec3), String> {
+    let (mut ids, mut seen) = (Vec::new(), FxHashMap::default());
+    let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+    for &id in outer.iter().chain(holes).flatten() {
+        ensure!((id as usize) < points.len(), "vertex id {id} out of range");
+        let p = points[id as usize];
+        check_coordinate(p).map_err(|e| format!("vertex {id} at {p}: {e}"))?;
+        if seen.insert(id, ()).is_none() {
+            (lo, hi) = (lo.min(p), hi.max(p));
+            ids.push(id);
+        }
+    }
+    for &h in hole_points {
+        check_coordinate(h).map_err(|e| format!("hole point {h}: {e}"))?;
+    }
+    let short = holes.iter().find(|h| h.len() < 3);
+    ensure!(short.is_none(), "hole {short:?}: under 3 vertices");
+    Ok((ids, lo, hi))
+}
+
+/// How a facet is projected to 2D and lifted for the in-circle test (see the module comment).
+struct Plane {
+    /// The dominant axis of the normal, dropped by the projection.
+    k: usize,
+    /// The 3D axes used as 2D (u, v), ordered so that the largest outer polygon is ccw.
+    axes: [usize; 2],
+    /// That polygon's vector area (Newell).
+    nrm: DVec3,
+    /// The unit normal, on the side from which that polygon is seen ccw.
+    normal: DVec3,
+    /// That polygon's vertex where its winding is read (lexicographically smallest in 2D).
+    v0: DVec3,
+    /// The lifting point E, off the plane on the normal's side.
+    eye: DVec3,
+}
+
+impl Plane {
+    /// Normal and projection from the outer polygon with the largest area; the exact winding
+    /// at its extreme vertex orders the 2D axes so that it is counter-clockwise. `lo`, `hi`:
+    /// the bounding box of the facet's vertices.
+    fn of(points: &[DVec3], outer: &[Vec<u32>], lo: DVec3, hi: DVec3) -> Result<Plane, String> {
         let (best, nrm) = outer
             .iter()
             .filter(|p| p.len() >= 3)
@@ -304,7 +319,41 @@ impl FacetMesh {
         let [a, b] = [best[(m + n - 1) % n], best[(m + 1) % n]].map(|i| points[i as usize]);
         let ok = orient3d(a, v0, b, eye) > 0.0;
         ensure!(ok, "polygon {best:?} is too far from planar");
+        Ok(Plane {
+            k,
+            axes,
+            nrm,
+            normal,
+            v0,
+            eye,
+        })
+    }
+}
 
+impl FacetMesh {
+    /// Triangulates a facet: `outer` polygons (vertex ids into `points`, in order; a 2-vertex
+    /// polygon is a lone segment, a 1-vertex one a lone point), `holes` polygons whose inside is
+    /// removed, and TetGen-style `hole_points` whose region (bounded by polygon edges) is removed.
+    /// All polygon edges become constrained edges; vertices lying exactly on one split it.
+    /// The result is the constrained Delaunay triangulation of the region.
+    ///
+    /// Errors (with ids and coordinates in the message): an id out of range or a bad coordinate,
+    /// no outer polygon with positive area, two vertices projecting to the same point, crossing
+    /// polygon edges, a constrained edge left entirely outside the facet, an empty facet.
+    pub fn new(
+        points: &[DVec3],
+        outer: &[Vec<u32>],
+        holes: &[Vec<u32>],
+        hole_points: &[DVec3],
+    ) -> Result<FacetMesh, String> {
+        let outer: Vec<Vec<u32>> = outer
+            .iter()
+            .map(|p| clean_polygon(p))
+            .filter(|p| !p.is_empty())
+            .collect();
+        let holes: Vec<Vec<u32>> = holes.iter().map(|p| clean_polygon(p)).collect();
+        let (ids, lo, hi) = checked_vertices(points, &outer, &holes, hole_points)?;
+        let plane = Plane::of(points, &outer, lo, hi)?;
         let mut fm = FacetMesh {
             tris: Vec::with_capacity(2 * ids.len() + 8),
             gid: Vec::new(),
@@ -312,94 +361,23 @@ impl FacetMesh {
             p2: Vec::new(),
             vtri: Vec::new(),
             local: FxHashMap::default(),
-            axes,
-            normal,
-            eye,
+            axes: plane.axes,
+            normal: plane.normal,
+            eye: plane.eye,
             n_inside: 0,
             expected_area: None,
             hint: 0,
         };
-        // Super-triangle well around the bounding box, its vertices put (in float) on the plane
-        // through v0 so that the lifting treats them like the others.
-        let (lo2, hi2) = (fm.proj(lo), fm.proj(hi));
-        let (c, r) = ((lo2 + hi2) * 0.5, (hi2 - lo2).max_element() * 0.5);
-        for (du, dv) in [(-20.0, -10.0), (20.0, -10.0), (0.0, 20.0)] {
-            let (mut p, [iu, iv]) = (DVec3::ZERO, axes);
-            (p[iu], p[iv]) = (c.x + du * r, c.y + dv * r);
-            p[k] = v0[k] - (nrm[iu] * (p[iu] - v0[iu]) + nrm[iv] * (p[iv] - v0[iv])) / nrm[k];
-            fm.add_vertex(NONE, p);
-        }
-        fm.new_tri();
-        fm.put(0, [0, 1, 2], 0);
-        // BRIO + Hilbert order: points along a polygon in order (e.g. a circle) would cost O(n)
-        // flips each; this keeps construction near O(n log n).
-        let order = brio_order(
-            &ids.iter().map(|&i| points[i as usize]).collect::<Vec<_>>(),
-            1,
-        );
-        for id in order.into_iter().map(|k| ids[k as usize]) {
-            let p = points[id as usize];
-            match fm.walk(fm.proj(p)) {
-                Loc::Vertex(t, i) => {
-                    let other = fm.gid[fm.tris[t as usize].v[i] as usize];
-                    return Err(format!("vertices {other} and {id} coincide ({p})"));
-                }
-                Loc::Outside => return Err(format!("internal: vertex {id} off super-triangle")),
-                loc => {
-                    let (l, new) = fm.place(loc, id, p);
-                    fm.legalize(l, new, &mut Vec::new());
-                    fm.hint = fm.vtri[l as usize];
-                }
-            }
-        }
-
+        fm.add_super_triangle(&plane, lo, hi);
+        fm.insert_vertices(points, &ids)?;
         let loc = |fm: &FacetMesh, id: u32| fm.local[&id];
         for poly in &outer {
             for (a, b) in poly_edges(poly) {
                 fm.recover(loc(&fm, a), loc(&fm, b))?;
             }
         }
-        // Flood fill the removed regions from the super-triangle, the inner side of each hole
-        // polygon edge and the hole points; constrained edges bound it.
-        let mut seeds = vec![fm.vtri[0]];
-        for poly in &holes {
-            let (w, _) = winding(poly, |id| fm.p2[loc(&fm, id) as usize]);
-            ensure!(w != 0.0, "hole {poly:?} degenerate/not simple");
-            for (a, b) in poly_edges(poly) {
-                for e in fm.recover(loc(&fm, a), loc(&fm, b))?.windows(2) {
-                    let (t, i) = fm.find_edge(e[0], e[1]).unwrap();
-                    let left = fm.tris[t as usize].v[nx(i)] == e[0];
-                    let other = fm.tris[t as usize].n[i] / 3;
-                    seeds.push(if left == (w > 0.0) { t } else { other });
-                }
-            }
-        }
-        for &h in hole_points {
-            if let Loc::In(t) | Loc::Edge(t, _) | Loc::Vertex(t, _) = fm.walk(fm.proj(h)) {
-                seeds.push(t);
-            }
-        }
-        let mut out = vec![false; fm.tris.len()];
-        while let Some(t) = seeds.pop() {
-            if !std::mem::replace(&mut out[t as usize], true) {
-                let tr = fm.tris[t as usize];
-                let open = |&i: &usize| !tr.cons(i) && tr.n[i] != NONE;
-                seeds.extend((0..3).filter(open).map(|i| tr.n[i] / 3));
-            }
-        }
-        for (tr, _) in fm.tris.iter_mut().zip(&out).filter(|(_, &o)| !o) {
-            tr.f |= INSIDE;
-            fm.n_inside += 1;
-        }
-        ensure!(fm.n_inside > 0, "holes cover the whole facet");
-        for tr in &fm.tris {
-            for i in (0..3).filter(|&i| tr.cons(i) && !tr.inside()) {
-                if !fm.tris[(tr.n[i] / 3) as usize].inside() {
-                    let e = fm.edge_ids(tr, i);
-                    return Err(format!("polygon edge {e:?} lies outside the facet"));
-                }
-            }
-        }
+        let seeds = fm.removed_region_seeds(&holes, hole_points)?;
+        fm.mark_inside(seeds)?;
         fm.make_cdt()?;
         fm.hint = fm.tris.iter().position(|t| t.inside()).unwrap() as u32;
         if hole_points.is_empty() {
@@ -408,6 +386,106 @@ impl FacetMesh {
             fm.expected_area = Some(a);
         }
         Ok(fm)
+    }
+
+    /// The super-triangle, well around the bounding box (`lo`, `hi`), its vertices put (in
+    /// float) on the plane through `plane.v0` so that the lifting treats them like the others.
+    fn add_super_triangle(&mut self, plane: &Plane, lo: DVec3, hi: DVec3) {
+        let (lo2, hi2) = (self.proj(lo), self.proj(hi));
+        let (c, r) = ((lo2 + hi2) * 0.5, (hi2 - lo2).max_element() * 0.5);
+        let (k, v0, nrm) = (plane.k, plane.v0, plane.nrm);
+        for (du, dv) in [(-20.0, -10.0), (20.0, -10.0), (0.0, 20.0)] {
+            let (mut p, [iu, iv]) = (DVec3::ZERO, plane.axes);
+            (p[iu], p[iv]) = (c.x + du * r, c.y + dv * r);
+            p[k] = v0[k] - (nrm[iu] * (p[iu] - v0[iu]) + nrm[iv] * (p[iv] - v0[iv])) / nrm[k];
+            self.add_vertex(NONE, p);
+        }
+        self.new_tri();
+        self.put(0, [0, 1, 2], 0);
+    }
+
+    /// Inserts the polygon vertices `ids` (Delaunay insertion, Lawson flips). BRIO + Hilbert
+    /// order: points along a polygon in order (e.g. a circle) would cost O(n) flips each; this
+    /// keeps construction near O(n log n).
+    fn insert_vertices(&mut self, points: &[DVec3], ids: &[u32]) -> Result<(), String> {
+        let order = brio_order(
+            &ids.iter().map(|&i| points[i as usize]).collect::<Vec<_>>(),
+            1,
+        );
+        for id in order.into_iter().map(|k| ids[k as usize]) {
+            let p = points[id as usize];
+            match self.walk(self.proj(p)) {
+                Loc::Vertex(t, i) => {
+                    let other = self.gid[self.tris[t as usize].v[i] as usize];
+                    return Err(format!("vertices {other} and {id} coincide ({p})"));
+                }
+                Loc::Outside => return Err(format!("internal: vertex {id} off super-triangle")),
+                loc => {
+                    let (l, new) = self.place(loc, id, p);
+                    self.legalize(l, new, &mut Vec::new());
+                    self.hint = self.vtri[l as usize];
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Recovers the hole polygons' edges and returns the seeds of the removed regions: the
+    /// super-triangle, the inner side of each hole polygon edge and the triangles holding the
+    /// hole points.
+    fn removed_region_seeds(
+        &mut self,
+        holes: &[Vec<u32>],
+        hole_points: &[DVec3],
+    ) -> Result<Vec<u32>, String> {
+        let loc = |fm: &FacetMesh, id: u32| fm.local[&id];
+        let mut seeds = vec![self.vtri[0]];
+        for poly in holes {
+            let (w, _) = winding(poly, |id| self.p2[loc(self, id) as usize]);
+            ensure!(w != 0.0, "hole {poly:?} degenerate/not simple");
+            for (a, b) in poly_edges(poly) {
+                for e in self.recover(loc(self, a), loc(self, b))?.windows(2) {
+                    let (t, i) = self.find_edge(e[0], e[1]).unwrap();
+                    let left = self.tris[t as usize].v[nx(i)] == e[0];
+                    let other = self.tris[t as usize].n[i] / 3;
+                    seeds.push(if left == (w > 0.0) { t } else { other });
+                }
+            }
+        }
+        for &h in hole_points {
+            if let Loc::In(t) | Loc::Edge(t, _) | Loc::Vertex(t, _) = self.walk(self.proj(h)) {
+                seeds.push(t);
+            }
+        }
+        Ok(seeds)
+    }
+
+    /// Flood fills the removed regions from `seeds` (constrained edges bound it) and flags
+    /// every other triangle inside the facet; fails if nothing is left or a polygon edge has
+    /// the removed region on both sides.
+    fn mark_inside(&mut self, mut seeds: Vec<u32>) -> Result<(), String> {
+        let mut out = vec![false; self.tris.len()];
+        while let Some(t) = seeds.pop() {
+            if !std::mem::replace(&mut out[t as usize], true) {
+                let tr = self.tris[t as usize];
+                let open = |&i: &usize| !tr.cons(i) && tr.n[i] != NONE;
+                seeds.extend((0..3).filter(open).map(|i| tr.n[i] / 3));
+            }
+        }
+        for (tr, _) in self.tris.iter_mut().zip(&out).filter(|(_, &o)| !o) {
+            tr.f |= INSIDE;
+            self.n_inside += 1;
+        }
+        ensure!(self.n_inside > 0, "holes cover the whole facet");
+        for tr in &self.tris {
+            for i in (0..3).filter(|&i| tr.cons(i) && !tr.inside()) {
+                if !self.tris[(tr.n[i] / 3) as usize].inside() {
+                    let e = self.edge_ids(tr, i);
+                    return Err(format!("polygon edge {e:?} lies outside the facet"));
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Inserts vertex `id` at `p` (a point of the facet, possibly a rounding error off its plane)

@@ -5,12 +5,14 @@
 mod domain;
 pub mod existing;
 mod mark;
+mod outcome;
 mod output;
 mod quality;
 mod recover;
 pub mod report;
 mod spacing;
 
+pub use outcome::Refusals;
 pub(crate) use quality::random_in_unit_ball;
 pub use spacing::AutoSpacing;
 
@@ -18,6 +20,7 @@ use crate::mesh::TetMesh;
 use crate::plc::PlcInput;
 use glam::DVec3;
 use mark::Unseeded;
+use recover::Settled;
 use rustc_hash::FxHashSet;
 
 /// Refinement parameters (names follow the paper).
@@ -271,6 +274,8 @@ pub struct Report {
     pub n_acute_angles: usize,
     /// Tets left violating a bound because they are within the influence of an acute angle.
     pub n_bad_near_acute: usize,
+    /// How often refinement left a bad tet as it was, per reason (see [`Refusals`]).
+    pub refusals: Refusals,
     /// Tets whose region (or inside/outside status) the check after refinement corrected:
     /// refinement keeps the labels incrementally (`Domain::retag_created`), so this is 0 unless
     /// that invariant broke (then one more pass refined them). 0 on every shared model.
@@ -443,7 +448,9 @@ fn mesh_domain(
         SmallAngles::None => {}
     }
     let mut budget = recover::MAX_RECOVERY_SPLITS.min(params.max_vertices.saturating_mul(4));
-    dom.recover_boundary(&mut budget)?;
+    if dom.recover_boundary(&mut budget)? == Settled::BudgetSpent {
+        return Err(recovery_budget_spent(params));
+    }
     let mut regions = dom.mark_domain(input, unseeded)?;
     let seconds_recovery = start.elapsed().as_secs_f64();
     let auto;
@@ -469,6 +476,7 @@ fn mesh_domain(
         mut stop_reason,
         blocked,
         n_relabelled,
+        refusals,
     } = passes;
     let seconds_refinement = start.elapsed().as_secs_f64() - seconds_recovery;
     let mesh = dom.to_mesh(&regions);
@@ -482,6 +490,7 @@ fn mesh_domain(
     report.seconds_total = start.elapsed().as_secs_f64();
     report.n_acute_angles = dom.acute_vertices.len();
     report.n_relabelled = n_relabelled;
+    report.refusals = refusals;
     report.complete = stop_reason.is_none() && (bad_elsewhere == 0 || !params.refine);
     if params.refine && stop_reason.is_none() && bad_elsewhere > 0 {
         stop_reason = Some(format!(
@@ -501,6 +510,28 @@ struct Passes {
     blocked: FxHashSet<[u32; 4]>,
     /// Tets whose region the check after refinement corrected (`Report::n_relabelled`).
     n_relabelled: usize,
+    /// Bad tets refinement left alone, per reason (`Report::refusals`).
+    refusals: Refusals,
+}
+
+/// Boundary recovery (before refinement, or the check after it) ran out of splits: there is
+/// no conforming mesh to report on. The budget is 4 x `max_vertices` when that is the smaller
+/// one, else the safety net against a recovery that cannot terminate.
+fn recovery_budget_spent(params: &Params) -> MeshError {
+    let limit = recover::MAX_RECOVERY_SPLITS;
+    MeshError::InvalidInput(if params.max_vertices.saturating_mul(4) < limit {
+        format!(
+            "boundary recovery needs more than {} splits (4 x max_vertices = {}): \
+             max_vertices is too small for this input",
+            params.max_vertices.saturating_mul(4),
+            params.max_vertices
+        )
+    } else {
+        format!(
+            "boundary recovery did not finish within {limit} splits (an input angle too \
+             small to protect in floating point?)"
+        )
+    })
 }
 
 /// The inputs of [`refine_passes`].
@@ -539,9 +570,12 @@ fn refine_passes(
         r.run(&mut on_step)?;
         out.stop_reason = r.stop_reason.take();
         out.blocked.extend(r.blocked_by_small_angle.drain());
+        out.refusals.add(&r.refusals);
         let refined = dom.dt.num_vertices();
         let labels = tet_labels(dom, regions);
-        dom.recover_boundary(ctx.budget)?;
+        if dom.recover_boundary(ctx.budget)? == Settled::BudgetSpent {
+            return Err(recovery_budget_spent(ctx.params));
+        }
         *regions = dom.mark_domain(ctx.input, ctx.unseeded)?;
         let relabelled = labels
             .iter()

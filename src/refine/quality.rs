@@ -5,9 +5,15 @@
 //! from the boundary check), else the best of up to `max_tries` random draws; when its
 //! circumcentre encroaches a subsegment or subfacet, that boundary element is split from its
 //! own picking interval or disk instead.
+//!
+//! Refining one bad tet (`refine_tet` and the helpers it returns through) decides and says
+//! what it did as an [`Outcome`]; `run`, the queue loop, keeps all the books (counts per
+//! refusal reason, the deferred queue, the tets left at once when looked at again).
 
 use super::domain::{seg_key, tri_key, Domain, VertexKind};
 use super::mark::Regions;
+use super::outcome::{BoundaryKind, Outcome, Refusal, Refusals};
+use super::recover::Settled;
 use super::{MeshError, Params, Spacing};
 use crate::delaunay::{tables::FACE, BoundaryFace, Cavity, Probe, INFINITE};
 use crate::geom::screen::{
@@ -74,20 +80,19 @@ pub struct Refiner<'a> {
     rng: ChaCha8Rng,
     /// One FIFO queue per badness class; the highest class is served first.
     queues: [VecDeque<Bad>; 3],
-    /// Flat tets with a far circumcentre, served after every queue is empty (see
-    /// `refine_tet`).
+    /// Flat tets with a far circumcentre, served after every queue is empty
+    /// ([`Outcome::Deferred`]).
     deferred: VecDeque<Bad>,
-    /// Bad tets left alone because fixing them needed an ever smaller boundary split (the
-    /// signature of an acute input angle).
-    pub gave_up: usize,
-    /// Bad tets (vertex quadruples) left alone because fixing them needed a split of a
-    /// boundary element next to a small input angle: they are within its influence.
+    /// How often a bad tet was left alone, per reason.
+    pub refusals: Refusals,
+    /// Bad tets (vertex quadruples) left alone within a small input angle's influence
+    /// ([`Refusal::within_small_angle`]).
     pub blocked_by_small_angle: FxHashSet<[u32; 4]>,
     /// Bad tets (vertex quadruples) whose circumcentre encroached a boundary element too small
-    /// to split, with nothing to restore around them: looked at again (flips and boundary
-    /// restoration re-queue them), they are left at once instead of probing that centre's
-    /// cavity again (thousands of tets next to a finely split boundary; most of keep-mode
-    /// oblong.off's time was such repeats).
+    /// to split, with nothing to restore around them ([`Refusal::remembered`]): looked at
+    /// again (flips and boundary restoration re-queue them), they are left at once
+    /// ([`Refusal::Futile`]) instead of probing that centre's cavity again (thousands of tets
+    /// next to a finely split boundary; most of keep-mode oblong.off's time was such repeats).
     futile: FxHashSet<[u32; 4]>,
     pub stop_reason: Option<String>,
     /// cos(params.min_dihedral): a tet whose largest dihedral cosine exceeds it is a sliver.
@@ -133,7 +138,7 @@ impl<'a> Refiner<'a> {
             regions,
             queues: Default::default(),
             deferred: VecDeque::new(),
-            gave_up: 0,
+            refusals: Refusals::default(),
             blocked_by_small_angle: FxHashSet::default(),
             futile: FxHashSet::default(),
             stop_reason: None,
@@ -267,45 +272,91 @@ impl<'a> Refiner<'a> {
         self.push_tets(&all)?;
         let mut steps = 0usize;
         while let Some((bad, was_deferred)) = self.next_bad() {
-            if !self.dom.dt.is_alive(bad.tet) || self.dom.dt.tet(bad.tet) != bad.verts {
+            if !self.is_current(bad) {
                 continue;
             }
             if self.dom.dt.num_vertices() >= self.params.max_vertices {
-                self.stop_reason = Some(format!(
-                    "vertex budget max_vertices = {} reached",
-                    self.params.max_vertices
-                ));
+                let max = self.params.max_vertices;
+                self.stop(format!("vertex budget max_vertices = {max} reached"), bad);
                 return Ok(());
             }
             steps += 1;
             if steps % 1024 == 0 && !progress(self.dom.dt.num_vertices()) {
                 return Err(MeshError::Cancelled);
             }
-            let gave_up = self.gave_up;
             let before = self.dom.dt.num_vertices();
-            self.refine_tet(bad, !was_deferred)?;
-            // A boundary split need not destroy the tet that asked for it: look again (only
-            // if something was inserted, or it would come back forever).
-            if self.gave_up == gave_up
-                && self.dom.dt.num_vertices() > before
-                && self.dom.dt.is_alive(bad.tet)
-                && self.dom.dt.tet(bad.tet) == bad.verts
-            {
-                self.push_tets(&[bad.tet])?;
+            let outcome = self.refine_tet(bad, !was_deferred)?;
+            if !self.record(bad, outcome, before)? {
+                return Ok(());
             }
         }
         Ok(())
     }
 
-    fn refine_tet(&mut self, bad: Bad, may_defer: bool) -> Result<(), MeshError> {
+    /// Whether queued bad tet `bad` is still a tet of the mesh.
+    fn is_current(&self, bad: Bad) -> bool {
+        self.dom.dt.is_alive(bad.tet) && self.dom.dt.tet(bad.tet) == bad.verts
+    }
+
+    /// The books of one refined bad tet (`n_before`: the vertex count before), all kept here:
+    /// refusals counted per reason, the tets left within a small angle's influence or left for
+    /// good, the deferred queue, and a second look at a tet that survived a split. Returns
+    /// false when refinement must stop.
+    fn record(&mut self, bad: Bad, outcome: Outcome, n_before: usize) -> Result<bool, MeshError> {
+        match outcome {
+            Outcome::Refused(reason) => {
+                self.refusals.count(reason);
+                if reason.remembered() {
+                    self.futile.insert(sorted4(bad.verts));
+                }
+                if reason.within_small_angle() {
+                    self.blocked_by_small_angle.insert(sorted4(bad.verts));
+                }
+            }
+            Outcome::Deferred => self.deferred.push_back(bad),
+            Outcome::BudgetSpent => {
+                let max = super::recover::MAX_RECOVERY_SPLITS;
+                self.stop(
+                    format!("boundary split budget ({max} splits after one insertion) spent"),
+                    bad,
+                );
+                return Ok(false);
+            }
+            Outcome::Inserted | Outcome::Split(_) | Outcome::Resettled => {
+                // A boundary split need not destroy the tet that asked for it: look again
+                // (only if something was inserted, or it would come back forever).
+                if self.dom.dt.num_vertices() > n_before && self.is_current(bad) {
+                    self.push_tets(&[bad.tet])?;
+                }
+            }
+        }
+        Ok(true)
+    }
+
+    /// Stops refinement for `reason` (a budget), counting the bad tets still queued (`bad`
+    /// among them while it is a tet) as left by the budget.
+    fn stop(&mut self, reason: String, bad: Bad) {
+        let queued = self.queues.iter().flatten().chain(&self.deferred);
+        let left: FxHashSet<u32> = std::iter::once(&bad)
+            .chain(queued)
+            .filter(|b| self.is_current(**b))
+            .map(|b| b.tet)
+            .collect();
+        self.refusals.count_budget(left.len());
+        self.stop_reason = Some(reason);
+    }
+
+    /// Refines bad tet `bad` (`may_defer`: it was not deferred already) by Li's point choice,
+    /// unless a guard below finds that nothing would help: says what it did, and `run` keeps
+    /// the books.
+    fn refine_tet(&mut self, bad: Bad, may_defer: bool) -> Result<Outcome, MeshError> {
         if self.futile.contains(&sorted4(bad.verts)) {
-            self.gave_up += 1;
-            return Ok(());
+            return Ok(Outcome::Refused(Refusal::Futile));
         }
         if self.dom.flat_by_construction(bad.verts) {
             // No point inside it or at its centre can help (see `flat_by_construction`):
             // restoring the boundary around it may; else the improvement removes it.
-            return self.resettle_or_give_up(bad.tet);
+            return self.resettle_or_refuse(bad.tet, Refusal::FlatByConstruction);
         }
         let near = bad.verts.iter().any(|&v| self.dom.near_acute(v));
         let [a, b, c, d] = self.dom.dt.tet_points(bad.tet);
@@ -316,16 +367,48 @@ impl<'a> Refiner<'a> {
             return self.insert_volume_point(centroid, 0.5 * longest_edge(a, b, c, d), bad.tet);
         }
         let Some((centre, r)) = circumsphere(a, b, c, d) else {
-            self.gave_up += 1;
-            return Ok(());
+            return Ok(Outcome::Refused(Refusal::NoCircumsphere));
         };
+        if let Some(outcome) = self.screen_circumcentre(bad, centre, r, near, may_defer)? {
+            return Ok(outcome);
+        }
+        let (centre_cavity, centre_breaks) = self.encroached_boundary(centre, Some(bad.tet));
+        if near {
+            // Only the centre, and only if it breaks no boundary (see `screen_circumcentre`).
+            // No cavity: the centre is a vertex already.
+            return match (centre_breaks, centre_cavity) {
+                (None, Some(cavity)) => self.insert_volume_vertex(centre, bad.tet, Some(cavity)),
+                _ => Ok(Outcome::Refused(Refusal::NearSmallAngle)),
+            };
+        }
+        if let Some(bnd) = centre_breaks {
+            return self.refine_encroached(bad, bnd, r);
+        }
+        self.insert_from_picking_ball(bad, centre, r, centre_cavity)
+    }
+
+    /// The guards on bad tet `bad`'s circumcentre `centre` (circumradius `r`; `near`: next to
+    /// a small angle) before its cavity is probed: what to do instead when the tet is flat to
+    /// rounding, its centre is far outside the domain, it is next to a small angle with a far
+    /// centre, or it must wait; None when the centre is worth probing.
+    fn screen_circumcentre(
+        &mut self,
+        bad: Bad,
+        centre: DVec3,
+        r: f64,
+        near: bool,
+        may_defer: bool,
+    ) -> Result<Option<Outcome>, MeshError> {
+        let [a, b, c, d] = self.dom.dt.tet_points(bad.tet);
         if insphere(a, b, c, d, centre) <= 0.0 {
             // The computed centre is not inside the tet's own circumsphere (exact test): the
             // tet is flat to rounding (four nearly cocircular points, seen on coplanar
             // boundary triangles of separate facets) and its float circumsphere is noise. A
             // point there would not remove the tet, and it would be drawn again without end;
             // only restoring the boundary around it can help.
-            return self.resettle_or_give_up(bad.tet);
+            return self
+                .resettle_or_refuse(bad.tet, Refusal::FlatToRounding)
+                .map(Some);
         }
         let centroid = (a + b + c + d) * 0.25;
         let le = longest_edge(a, b, c, d);
@@ -333,10 +416,12 @@ impl<'a> Refiner<'a> {
         {
             // A nearly flat tet next to the boundary (four almost cocircular points): its
             // circumcentre is outside the domain and far away; it would encroach only
-            // boundary elements far smaller than r (the cascade the guard below refuses), and
-            // locating it costs a long walk through exact predicates. Only restoring the
+            // boundary elements far smaller than r (the cascade `refine_encroached` refuses),
+            // and locating it costs a long walk through exact predicates. Only restoring the
             // boundary around it can help.
-            return self.resettle_or_give_up(bad.tet);
+            return self
+                .resettle_or_refuse(bad.tet, Refusal::FarCentre)
+                .map(Some);
         }
         // Next to a small angle shape is improved only by the circumcentre, and only when it
         // breaks no boundary: splitting the boundary there for shape would never end (the
@@ -346,7 +431,7 @@ impl<'a> Refiner<'a> {
         // 10-30% fewer bad tets (measured on the .off models). A tet the centre does not fix
         // is left, counted as within the angle's influence.
         if near && r > le {
-            return self.leave_near_small_angle(bad);
+            return Ok(Some(Outcome::Refused(Refusal::NearSmallAngle)));
         }
         // A flat tet with a far circumcentre (one hugging the boundary, made by a boundary
         // split) waits until every other bad tet is handled: by then most are gone, and its
@@ -354,8 +439,7 @@ impl<'a> Refiner<'a> {
         // every one ending in a refused boundary split).
         if r > DEFER_RADIUS_PER_EDGE * le {
             if may_defer {
-                self.deferred.push_back(bad);
-                return Ok(());
+                return Ok(Some(Outcome::Deferred));
             }
             // Deferred already: when its circumcentre lies outside the domain, probing that
             // centre means a huge cavity (thousands of tets) that crosses the boundary, which
@@ -363,21 +447,12 @@ impl<'a> Refiner<'a> {
             // Restoring the boundary around it is all that can help.
             let t = self.dom.dt.locate_point(centre, Some(bad.tet));
             if !self.dom.dt.is_finite(t) || self.dom.dt.tag(t) == 0 {
-                return self.resettle_or_give_up(bad.tet);
+                return self
+                    .resettle_or_refuse(bad.tet, Refusal::CentreOutsideDomain)
+                    .map(Some);
             }
         }
-        let (centre_cavity, centre_breaks) = self.encroached_boundary(centre, Some(bad.tet));
-        if near {
-            // No cavity: the centre is a vertex already.
-            return match (centre_breaks, centre_cavity) {
-                (None, Some(cavity)) => self.insert_volume_vertex(centre, bad.tet, Some(cavity)),
-                _ => self.leave_near_small_angle(bad),
-            };
-        }
-        if let Some(bnd) = centre_breaks {
-            return self.refine_encroached(bad, bnd, r);
-        }
-        self.insert_from_picking_ball(bad, centre, r, centre_cavity)
+        Ok(None)
     }
 
     /// Inserts the best point of bad tet `bad`'s picking ball (centre `centre`, circumradius
@@ -389,7 +464,7 @@ impl<'a> Refiner<'a> {
         centre: DVec3,
         r: f64,
         centre_cavity: Option<Cavity>,
-    ) -> Result<(), MeshError> {
+    ) -> Result<Outcome, MeshError> {
         // Draw candidates from the picking ball; keep the one with fewest small slivers among
         // those that break no boundary.
         let mut best = None;
@@ -429,19 +504,30 @@ impl<'a> Refiner<'a> {
         p: DVec3,
         hint: u32,
         cavity: Option<Cavity>,
-    ) -> Result<(), MeshError> {
+    ) -> Result<Outcome, MeshError> {
         self.dom
             .insert_point(p, super::domain::VertexKind::Volume, Some(hint), cavity)?;
-        self.settle_boundary()?;
-        self.push_recent()
+        self.settle_and_queue(Outcome::Inserted)
+    }
+
+    /// After an insertion: restores empty encroachment around it and queues the new bad
+    /// tets. Returns `done`, or `BudgetSpent` when the split budget ran out first.
+    fn settle_and_queue(&mut self, done: Outcome) -> Result<Outcome, MeshError> {
+        let mut budget = super::recover::MAX_RECOVERY_SPLITS;
+        let settled = self.dom.settle(&mut budget)?;
+        self.push_recent()?;
+        Ok(match settled {
+            Settled::Conforming => done,
+            Settled::BudgetSpent => Outcome::BudgetSpent,
+        })
     }
 
     /// Bad tet `bad` (circumradius `r`), whose circumcentre encroaches boundary element `bnd`
     /// (or whose cavity crosses it): split `bnd` from its picking region, unless it touches a
     /// small angle or is much smaller than the tet.
-    fn refine_encroached(&mut self, bad: Bad, bnd: Boundary, r: f64) -> Result<(), MeshError> {
+    fn refine_encroached(&mut self, bad: Bad, bnd: Boundary, r: f64) -> Result<Outcome, MeshError> {
         if self.is_protected(bnd) {
-            return self.leave_near_small_angle(bad);
+            return Ok(Outcome::Refused(Refusal::NearSmallAngle));
         }
         let rb = self.boundary_radius(bnd);
         // Without small input angles an encroached boundary element has R >= R_tau / 2
@@ -452,28 +538,25 @@ impl<'a> Refiner<'a> {
         }
         // Restoring the boundary around the tet is all that may help. When it split anything,
         // `bnd` (and the tet) may be gone: `bnd` is never split for this tet, which `run`
-        // looks at again if it survived.
-        if self.resettle_near(bad.tet)? {
-            return Ok(());
-        }
-        self.gave_up += 1;
-        self.futile.insert(sorted4(bad.verts));
-        if self
+        // looks at again if it survived. When it split nothing, the tet is left for good.
+        let cascade = if self
             .boundary_vertices(bnd)
             .iter()
             .any(|&v| v != u32::MAX && self.dom.influenced_by_acute_angle(v))
         {
-            self.blocked_by_small_angle.insert(sorted4(bad.verts));
-        }
-        Ok(())
+            Refusal::CascadeNearSmallAngle
+        } else {
+            Refusal::Cascade
+        };
+        self.resettle_or_refuse(bad.tet, cascade)
     }
 
     /// Inserts `p` (for size-bad tet `t` of size `r`) unless it would break the boundary; then
     /// the boundary element is split instead if it is not much smaller than `r`, else nothing.
-    fn insert_volume_point(&mut self, p: DVec3, r: f64, t: u32) -> Result<(), MeshError> {
+    fn insert_volume_point(&mut self, p: DVec3, r: f64, t: u32) -> Result<Outcome, MeshError> {
         let Probe::Cavity(cavity) = self.dom.dt.probe(p, Some(t)) else {
-            self.gave_up += 1; // p is a vertex already (a flat tet's centroid can be)
-            return Ok(());
+            // p is a vertex already (a flat tet's centroid can be)
+            return Ok(Outcome::Refused(Refusal::Duplicate));
         };
         if let Some(bnd) = self.boundary_in_cavity(&cavity) {
             // Only size refinement comes here: the boundary element is split even next to a
@@ -482,21 +565,15 @@ impl<'a> Refiner<'a> {
             if self.boundary_radius(bnd) >= 0.25 * r {
                 return self.split_boundary(bnd, r);
             }
-            if self.is_protected(bnd) {
-                self.blocked_by_small_angle
-                    .insert(sorted4(self.dom.dt.tet(t)));
-            }
-            self.gave_up += 1;
-            return Ok(());
+            // A much smaller one would start a cascade (see `refine_encroached`): the tet is
+            // left, within the small angle's influence when the element touches one.
+            return Ok(Outcome::Refused(if self.is_protected(bnd) {
+                Refusal::NearSmallAngle
+            } else {
+                Refusal::CentroidCascade
+            }));
         }
         self.insert_volume_vertex(p, t, Some(cavity))
-    }
-
-    /// Leaves bad tet `bad` as it is: it is within a small input angle's influence.
-    fn leave_near_small_angle(&mut self, bad: Bad) -> Result<(), MeshError> {
-        self.gave_up += 1;
-        self.blocked_by_small_angle.insert(sorted4(bad.verts));
-        Ok(())
     }
 
     fn random_in_ball(&mut self) -> DVec3 {
@@ -672,11 +749,23 @@ impl<'a> Refiner<'a> {
         None
     }
 
-    /// Queues the subsegments and subfacets around tet `t` and restores empty encroachment
-    /// there. Returns whether anything was split (a vertex of `t` may be the encroacher that
-    /// made it hug the boundary).
-    fn resettle_near(&mut self, t: u32) -> Result<bool, MeshError> {
+    /// Restores empty encroachment around tet `t` (a vertex of `t` may be the encroacher that
+    /// made it hug the boundary): `Resettled` if that split anything, else refused for
+    /// `reason`.
+    fn resettle_or_refuse(&mut self, t: u32, reason: Refusal) -> Result<Outcome, MeshError> {
         let n_before = self.dom.dt.num_vertices();
+        self.queue_boundary_around(t);
+        Ok(match self.settle_and_queue(Outcome::Resettled)? {
+            Outcome::Resettled if self.dom.dt.num_vertices() == n_before => {
+                Outcome::Refused(reason)
+            }
+            outcome => outcome,
+        })
+    }
+
+    /// Queues the subsegments and subfacets among the edges and faces of tet `t` and its
+    /// neighbours.
+    fn queue_boundary_around(&mut self, t: u32) {
         let mut near = vec![t];
         near.extend(self.dom.dt.neighbors(t));
         for u in near {
@@ -697,17 +786,6 @@ impl<'a> Refiner<'a> {
                 }
             }
         }
-        self.settle_boundary()?;
-        self.push_recent()?;
-        Ok(self.dom.dt.num_vertices() > n_before)
-    }
-
-    /// [`Self::resettle_near`], counting the tet as given up when nothing was split.
-    fn resettle_or_give_up(&mut self, t: u32) -> Result<(), MeshError> {
-        if !self.resettle_near(t)? {
-            self.gave_up += 1;
-        }
-        Ok(())
     }
 
     /// Whether refinement must not split boundary element `b`: it touches a small input
@@ -739,72 +817,88 @@ impl<'a> Refiner<'a> {
 
     /// Splits a boundary element from its picking region, then restores empty encroachment
     /// around the new vertex.
-    fn split_boundary(&mut self, b: Boundary, _r_tau: f64) -> Result<(), MeshError> {
-        match b {
-            Boundary::Segment(a, c) => self.split_segment_picked(a, c)?,
-            Boundary::Facet(f, t) => {
-                let [x, y, z] = t.map(|v| self.dom.point(v));
-                let Some(cf) = tri_circumcenter(x, y, z) else {
-                    self.gave_up += 1;
-                    return Ok(());
-                };
-                // The facet's plane snap and subsegment balls, once for the centre and all
-                // the draws (the same tests as snap_to_facet_plane and
-                // facet_subsegments_encroached_by, which walk the whole facet).
-                let snap = PlaneSnap::of(self.dom, f);
-                let balls = subsegment_balls(self.dom, f);
-                let cf = snap.apply(cf);
-                let enc = balls
-                    .iter()
-                    .filter(|b| cf.distance_squared(b.centre) <= b.r2)
-                    .map(|b| b.key)
-                    .min();
-                if let Some((a, c)) = enc {
-                    self.split_segment_picked(a, c)?;
-                } else if self.dom.facets[f as usize].locate(cf).is_none() {
-                    self.gave_up += 1;
-                    return Ok(());
-                } else {
-                    let rf = cf.distance(x);
-                    let n = (y - x).cross(z - x).normalize();
-                    let u = (y - x).normalize();
-                    let w = n.cross(u);
-                    // The centre first (it passed the facet checks above), then random draws.
-                    let mut best = None;
-                    let hint = self.dom.dt.vertex_tet(t[0]);
-                    let centre_ok = self.try_candidate(cf, rf, hint, Some(b), &mut best);
-                    for _ in 0..if centre_ok {
-                        0
-                    } else {
-                        self.params.max_tries.max(1)
-                    } {
-                        let (s, th) = (
-                            self.rng.gen::<f64>().sqrt(),
-                            self.rng.gen::<f64>() * std::f64::consts::TAU,
-                        );
-                        let p = cf + (u * th.cos() + w * th.sin()) * (s * self.params.delta * rf);
-                        let p = snap.apply(p);
-                        if self.dom.facets[f as usize].locate(p).is_none()
-                            || balls.iter().any(|b| p.distance_squared(b.centre) <= b.r2)
-                        {
-                            continue;
-                        }
-                        let hint = self.dom.dt.vertex_tet(t[0]);
-                        if self.try_candidate(p, rf, hint, Some(b), &mut best) {
-                            break;
-                        }
-                    }
-                    let (p, cavity) = match best {
-                        Some(c) => (c.cavity.point(), Some(c.cavity)),
-                        None => (cf, None),
-                    };
-                    let hint = self.dom.dt.vertex_tet(t[0]);
-                    self.dom.split_in_facet(f, p, hint, cavity)?;
-                }
+    fn split_boundary(&mut self, b: Boundary, _r_tau: f64) -> Result<Outcome, MeshError> {
+        let split = match b {
+            Boundary::Segment(a, c) => {
+                self.split_segment_picked(a, c)?;
+                BoundaryKind::Segment
+            }
+            Boundary::Facet(f, t) => match self.split_subfacet_picked(f, t)? {
+                Ok(kind) => kind,
+                Err(refusal) => return Ok(Outcome::Refused(refusal)),
+            },
+        };
+        self.settle_and_queue(Outcome::Split(split))
+    }
+
+    /// Splits subfacet `t` of facet `f` from its picking disk (its circumcentre first, then
+    /// random draws), or the facet's subsegment that centre encroaches. Returns the kind of
+    /// element split, or why nothing was.
+    fn split_subfacet_picked(
+        &mut self,
+        f: u32,
+        t: [u32; 3],
+    ) -> Result<Result<BoundaryKind, Refusal>, MeshError> {
+        let [x, y, z] = t.map(|v| self.dom.point(v));
+        let Some(cf) = tri_circumcenter(x, y, z) else {
+            return Ok(Err(Refusal::FlatSubfacet));
+        };
+        // The facet's plane snap and subsegment balls, once for the centre and all the draws
+        // (the same tests as snap_to_facet_plane and facet_subsegments_encroached_by, which
+        // walk the whole facet).
+        let snap = PlaneSnap::of(self.dom, f);
+        let balls = subsegment_balls(self.dom, f);
+        let cf = snap.apply(cf);
+        let enc = balls
+            .iter()
+            .filter(|b| cf.distance_squared(b.centre) <= b.r2)
+            .map(|b| b.key)
+            .min();
+        if let Some((a, c)) = enc {
+            self.split_segment_picked(a, c)?;
+            return Ok(Ok(BoundaryKind::Segment));
+        }
+        if self.dom.facets[f as usize].locate(cf).is_none() {
+            return Ok(Err(Refusal::SubfacetCentreOutside));
+        }
+        let rf = cf.distance(x);
+        let n = (y - x).cross(z - x).normalize();
+        let u = (y - x).normalize();
+        let w = n.cross(u);
+        // The centre first (it passed the facet checks above), then random draws.
+        let mut best = None;
+        let b = Boundary::Facet(f, t);
+        let hint = self.dom.dt.vertex_tet(t[0]);
+        let centre_ok = self.try_candidate(cf, rf, hint, Some(b), &mut best);
+        let tries = if centre_ok {
+            0
+        } else {
+            self.params.max_tries.max(1)
+        };
+        for _ in 0..tries {
+            let (s, th) = (
+                self.rng.gen::<f64>().sqrt(),
+                self.rng.gen::<f64>() * std::f64::consts::TAU,
+            );
+            let p = cf + (u * th.cos() + w * th.sin()) * (s * self.params.delta * rf);
+            let p = snap.apply(p);
+            if self.dom.facets[f as usize].locate(p).is_none()
+                || balls.iter().any(|b| p.distance_squared(b.centre) <= b.r2)
+            {
+                continue;
+            }
+            let hint = self.dom.dt.vertex_tet(t[0]);
+            if self.try_candidate(p, rf, hint, Some(b), &mut best) {
+                break;
             }
         }
-        self.settle_boundary()?;
-        self.push_recent()
+        let (p, cavity) = match best {
+            Some(c) => (c.cavity.point(), Some(c.cavity)),
+            None => (cf, None),
+        };
+        let hint = self.dom.dt.vertex_tet(t[0]);
+        self.dom.split_in_facet(f, p, hint, cavity)?;
+        Ok(Ok(BoundaryKind::Facet))
     }
 
     /// Splits subsegment ac from its picking interval (midpoint +- delta/2 of its length), or at
@@ -833,12 +927,6 @@ impl<'a> Refiner<'a> {
         };
         self.dom.split_subsegment(a, c, p, cavity)?;
         Ok(())
-    }
-
-    /// After a boundary split, restores empty encroachment around it.
-    fn settle_boundary(&mut self) -> Result<(), MeshError> {
-        let mut budget = super::recover::MAX_RECOVERY_SPLITS;
-        self.dom.settle(&mut budget)
     }
 }
 
@@ -1050,7 +1138,10 @@ mod tests {
         let plc = crate::plc::validate(&input).unwrap();
         let mut dom = Domain::new(&input).unwrap();
         dom.set_acute_angles(&plc, f64::INFINITY);
-        dom.recover_boundary(&mut 1_000_000).unwrap();
+        assert_eq!(
+            dom.recover_boundary(&mut 1_000_000).unwrap(),
+            Settled::Conforming
+        );
         let regions = dom
             .mark_domain(&input, super::super::mark::Unseeded::Domain)
             .unwrap();
@@ -1071,7 +1162,7 @@ mod tests {
 
     /// The stale-element case of `refine_encroached`: a bad tet's centre encroaches a
     /// subsegment much smaller than the tet, so the boundary around the tet is restored first
-    /// (`resettle_near`). When that split the very subsegment, the element found before the
+    /// (`resettle_or_refuse`). When that split the very subsegment, the element found before the
     /// change is gone and must not be split again: it used to be, which failed with an
     /// internal error ("(0, 1) is not a subsegment"; a stale subfacet would have been split
     /// at the centre of a triangle no longer in its facet).
@@ -1081,9 +1172,12 @@ mod tests {
         let spacing = super::super::ConstantSpacing(10.0);
         // What restoring the boundary alone does.
         let (mut dom, regions, t) = cube_with_unsettled_subsegment();
-        assert!(Refiner::new(&mut dom, &params, &spacing, &regions)
-            .resettle_near(t)
-            .unwrap());
+        assert_eq!(
+            Refiner::new(&mut dom, &params, &spacing, &regions)
+                .resettle_or_refuse(t, Refusal::Cascade)
+                .unwrap(),
+            Outcome::Resettled
+        );
         let expected = dom.dt.num_vertices();
         assert!(!dom.subsegs.contains_key(&(0, 1)));
         // A tet 20 times the subsegment's radius asks for it to be split: refused (much
@@ -1096,10 +1190,63 @@ mod tests {
             verts: dom.dt.tet(t),
         };
         let mut refiner = Refiner::new(&mut dom, &params, &spacing, &regions);
-        refiner
+        let outcome = refiner
             .refine_encroached(bad, Boundary::Segment(0, 1), 20.0 * 0.5)
             .expect("no split of a subsegment that is gone");
+        assert_eq!(outcome, Outcome::Resettled);
         assert_eq!(dom.dt.num_vertices(), expected);
+    }
+
+    /// The books `run` keeps, from the outcomes: on the settled unit cube, a tet asked to
+    /// split a subsegment a fifth of its size finds nothing to restore around it: refused for
+    /// a cascade and remembered, so looked at again it is futile at once; a centroid on a
+    /// vertex is a duplicate. Each is counted under its reason and in the total.
+    #[test]
+    fn refusals_are_counted_and_cascades_remembered() {
+        let input = cube_input();
+        let plc = crate::plc::validate(&input).unwrap();
+        let mut dom = Domain::new(&input).unwrap();
+        dom.set_acute_angles(&plc, f64::INFINITY);
+        assert_eq!(
+            dom.recover_boundary(&mut 1_000_000).unwrap(),
+            Settled::Conforming
+        );
+        let regions = dom
+            .mark_domain(&input, super::super::mark::Unseeded::Domain)
+            .unwrap();
+        let t = dom
+            .dt
+            .vertex_star(0)
+            .into_iter()
+            .find(|&t| dom.dt.is_finite(t) && dom.dt.tag(t) != 0)
+            .expect("an inside tet at vertex 0");
+        let seg = *dom.subsegs.keys().min().unwrap();
+        let rb = 0.5 * dom.point(seg.0).distance(dom.point(seg.1));
+        let bad = Bad {
+            class: RATIO,
+            badness: 10.0,
+            tet: t,
+            verts: dom.dt.tet(t),
+        };
+        let (params, spacing) = (Params::default(), super::super::ConstantSpacing(10.0));
+        let mut refiner = Refiner::new(&mut dom, &params, &spacing, &regions);
+        let n = refiner.dom.dt.num_vertices();
+        let outcome = refiner
+            .refine_encroached(bad, Boundary::Segment(seg.0, seg.1), 5.0 * rb)
+            .unwrap();
+        assert_eq!(outcome, Outcome::Refused(Refusal::Cascade));
+        assert!(refiner.record(bad, outcome, n).unwrap());
+        let again = refiner.refine_tet(bad, true).unwrap();
+        assert_eq!(again, Outcome::Refused(Refusal::Futile));
+        assert!(refiner.record(bad, again, n).unwrap());
+        let on_vertex = refiner.dom.point(0);
+        let duplicate = refiner.insert_volume_point(on_vertex, 1.0, t).unwrap();
+        assert_eq!(duplicate, Outcome::Refused(Refusal::Duplicate));
+        assert!(refiner.record(bad, duplicate, n).unwrap());
+        assert_eq!(refiner.dom.dt.num_vertices(), n);
+        let r = &refiner.refusals;
+        assert_eq!((r.cascade, r.futile, r.duplicate, r.total), (1, 1, 1, 3));
+        assert!(refiner.blocked_by_small_angle.is_empty());
     }
 
     /// Tets that are flat by construction (three vertices on one segment, or four in one
@@ -1109,7 +1256,10 @@ mod tests {
     fn flat_by_construction_names_collinear_and_coplanar_tets() {
         let input = cube_input();
         let mut dom = Domain::new(&input).unwrap();
-        dom.recover_boundary(&mut 1_000_000).unwrap();
+        assert_eq!(
+            dom.recover_boundary(&mut 1_000_000).unwrap(),
+            Settled::Conforming
+        );
         let s = dom
             .segments
             .iter()

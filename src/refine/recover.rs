@@ -15,6 +15,16 @@ use glam::DVec3;
 /// concentric shells cannot help within floating point): the number of splits allowed.
 pub const MAX_RECOVERY_SPLITS: usize = 2_000_000;
 
+/// Whether boundary recovery finished.
+#[must_use]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Settled {
+    /// Every subsegment and subfacet is present and unencroached (unless protected).
+    Conforming,
+    /// The split budget ran out first: the boundary may not conform.
+    BudgetSpent,
+}
+
 /// Why a boundary element is not conforming yet.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Status {
@@ -25,7 +35,7 @@ enum Status {
 
 impl Domain {
     /// Splits until every subsegment and subfacet is present and unencroached.
-    pub fn recover_boundary(&mut self, budget: &mut usize) -> Result<(), MeshError> {
+    pub fn recover_boundary(&mut self, budget: &mut usize) -> Result<Settled, MeshError> {
         let mut segs: Vec<(u32, u32)> = self.subsegs.keys().copied().collect();
         segs.sort_unstable(); // deterministic order
         let mut tris: Vec<[u32; 3]> = self.subfacets.keys().copied().collect();
@@ -70,29 +80,35 @@ impl Domain {
     }
 
     /// Works through the queued subsegments (first) and subfacets until none is missing or
-    /// encroached; every split queues what it creates or may encroach.
-    pub fn settle(&mut self, budget: &mut usize) -> Result<(), MeshError> {
+    /// encroached; every split queues what it creates or may encroach. Each split spends one
+    /// unit of `budget`.
+    pub fn settle(&mut self, budget: &mut usize) -> Result<Settled, MeshError> {
         loop {
             if let Some((a, b)) = self.dirty_segs.pop() {
                 if !self.subsegs.contains_key(&(a, b)) || self.subsegment_status(a, b) == Status::Ok
                 {
                     continue;
                 }
-                spend(budget)?;
+                if !spend(budget) {
+                    return Ok(Settled::BudgetSpent);
+                }
                 let p = self.segment_split_point(a, b);
                 self.split_subsegment(a, b, p, None)?;
                 continue;
             }
             let Some(tri) = self.dirty_tris.pop() else {
-                return Ok(());
+                return Ok(Settled::Conforming);
             };
             let Some(&f) = self.subfacets.get(&tri) else {
                 continue;
             };
-            match self.subfacet_status(tri) {
-                Status::Ok => {}
-                Status::Missing if self.flip_to_match(f, tri) => {}
+            let within_budget = match self.subfacet_status(tri) {
+                Status::Ok => true,
+                Status::Missing if self.flip_to_match(f, tri) => true,
                 _ => self.split_subfacet(f, tri, budget)?,
+            };
+            if !within_budget {
+                return Ok(Settled::BudgetSpent);
             }
         }
     }
@@ -183,13 +199,14 @@ impl Domain {
 
     /// Splits subfacet `tri` of facet `f` at its circumcentre, or, when that centre lies
     /// outside the facet or encroaches one of the facet's subsegments, splits those
-    /// subsegments instead.
+    /// subsegments instead. Returns false when `budget` ran out (before any split or between
+    /// two).
     fn split_subfacet(
         &mut self,
         f: u32,
         tri: [u32; 3],
         budget: &mut usize,
-    ) -> Result<(), MeshError> {
+    ) -> Result<bool, MeshError> {
         let [a, b, c] = tri.map(|v| self.point(v));
         let Some(centre) = tri_circumcenter(a, b, c) else {
             return Err(MeshError::Internal(format!(
@@ -201,12 +218,14 @@ impl Domain {
         if !encroached.is_empty() {
             for (x, y) in encroached {
                 if self.subsegs.contains_key(&(x, y)) {
-                    spend(budget)?;
+                    if !spend(budget) {
+                        return Ok(false);
+                    }
                     let p = self.segment_split_point(x, y);
                     self.split_subsegment(x, y, p, None)?;
                 }
             }
-            return Ok(());
+            return Ok(true);
         }
         // The centre may still be refused: beyond a subsegment that it does not encroach
         // (possible when a protected subsegment is left encroached), split that subsegment
@@ -216,17 +235,21 @@ impl Domain {
         let p = if fm.locate(centre).is_some() && fm.can_insert(centre).is_ok() {
             centre
         } else if let Some([x, y]) = fm.constrained_edge_towards(tri, centre) {
-            spend(budget)?;
+            if !spend(budget) {
+                return Ok(false);
+            }
             let p = self.segment_split_point(x, y);
             self.split_subsegment(x, y, p, None)?;
-            return Ok(());
+            return Ok(true);
         } else {
             (a + b + c) / 3.0
         };
-        spend(budget)?;
+        if !spend(budget) {
+            return Ok(false);
+        }
         let hint = self.dt.vertex_tet(tri[0]);
         self.split_in_facet(f, p, hint, None)?;
-        Ok(())
+        Ok(true)
     }
 
     /// Subsegments of facet `f` whose closed diametric ball contains `p` (up to rounding).
@@ -264,12 +287,11 @@ impl Domain {
     }
 }
 
-pub fn spend(budget: &mut usize) -> Result<(), MeshError> {
+/// Spends one split of `budget`; false (nothing spent) when it is spent already.
+fn spend(budget: &mut usize) -> bool {
     if *budget == 0 {
-        return Err(MeshError::Internal(
-            "boundary recovery did not terminate within its split budget".into(),
-        ));
+        return false;
     }
     *budget -= 1;
-    Ok(())
+    true
 }

@@ -155,6 +155,7 @@ impl Report {
             "bad tets left near acute",
             self.n_bad_near_acute.to_string(),
         );
+        row("refinement refusals", self.refusals.summary());
         row(
             "complete",
             match &self.stop_reason {
