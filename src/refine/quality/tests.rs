@@ -1,0 +1,183 @@
+//! Tests of the quality refinement's decisions and books.
+
+use super::*;
+
+/// The unit cube as a PLC (six quadrilateral facets).
+fn cube_input() -> crate::plc::PlcInput {
+    let vertices = (0..8)
+        .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, (i >> 2) as f64))
+        .collect();
+    let quads = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    crate::plc::PlcInput {
+        vertices,
+        facets: quads
+            .iter()
+            .map(|q| crate::plc::Facet {
+                polygons: vec![q.to_vec()],
+                hole_points: vec![],
+                hole_polygons: vec![],
+                marker: 1,
+            })
+            .collect(),
+        ..Default::default()
+    }
+}
+
+/// The unit cube meshed to a conforming boundary and marked: its domain and regions.
+fn settled_cube() -> (Domain, Regions) {
+    let input = cube_input();
+    let plc = crate::plc::validate(&input).unwrap();
+    let mut dom = Domain::new(&input).unwrap();
+    dom.set_acute_angles(&plc, f64::INFINITY);
+    assert_eq!(
+        dom.recover_boundary(&mut 1_000_000).unwrap(),
+        Settled::Conforming
+    );
+    let regions = dom
+        .mark_domain(&input, super::super::mark::Unseeded::Domain)
+        .unwrap();
+    (dom, regions)
+}
+
+/// The unit cube meshed to a conforming boundary, then a volume vertex put in the
+/// diametric ball of subsegment (0, 1) without restoring the boundary (the state a leak in
+/// the incremental bookkeeping would leave): the subsegment stays an edge (a hull edge of
+/// the cube), encroached. Returns the domain, its regions and an inside tet on the edge.
+fn cube_with_unsettled_subsegment() -> (Domain, Regions, u32) {
+    let (mut dom, regions) = settled_cube();
+    let mid = dom.point(0).midpoint(dom.point(1));
+    let p = mid + (DVec3::splat(0.5) - mid).normalize() * 0.2;
+    dom.insert_point(p, VertexKind::Volume, None, None).unwrap();
+    dom.dirty_segs.clear();
+    dom.dirty_tris.clear();
+    dom.created_log.clear();
+    let t = dom
+        .dt
+        .vertex_star(0)
+        .into_iter()
+        .find(|&t| dom.dt.is_finite(t) && dom.dt.tag(t) != 0 && dom.dt.tet(t).contains(&1))
+        .expect("an inside tet on the subsegment");
+    (dom, regions, t)
+}
+
+/// The stale-element case of `refine_encroached`: a bad tet's centre encroaches a
+/// subsegment much smaller than the tet, so the boundary around the tet is restored first
+/// (`resettle_or_refuse`). When that split the very subsegment, the element found before the
+/// change is gone and must not be split again: it used to be, which failed with an
+/// internal error ("(0, 1) is not a subsegment"; a stale subfacet would have been split
+/// at the centre of a triangle no longer in its facet).
+#[test]
+fn encroached_element_gone_after_resettling_is_not_split() {
+    let params = Params::default();
+    let spacing = super::super::ConstantSpacing(10.0);
+    // What restoring the boundary alone does.
+    let (mut dom, regions, t) = cube_with_unsettled_subsegment();
+    assert_eq!(
+        Refiner::new(&mut dom, &params, &spacing, &regions)
+            .resettle_or_refuse(t, Refusal::Cascade)
+            .unwrap(),
+        Outcome::Resettled
+    );
+    let expected = dom.dt.num_vertices();
+    assert!(!dom.subsegs.contains_key(&(0, 1)));
+    // A tet 20 times the subsegment's radius asks for it to be split: refused (much
+    // smaller than the tet), the boundary is restored, and nothing else is split.
+    let (mut dom, regions, t) = cube_with_unsettled_subsegment();
+    let bad = Bad {
+        class: RATIO,
+        badness: 10.0,
+        tet: t,
+        verts: dom.dt.tet(t),
+    };
+    let mut refiner = Refiner::new(&mut dom, &params, &spacing, &regions);
+    let outcome = refiner
+        .refine_encroached(bad, Boundary::Segment(0, 1), 20.0 * 0.5)
+        .expect("no split of a subsegment that is gone");
+    assert_eq!(outcome, Outcome::Resettled);
+    assert_eq!(dom.dt.num_vertices(), expected);
+}
+
+/// The books `run` keeps, from the outcomes: on the settled unit cube, a tet asked to
+/// split a subsegment a fifth of its size finds nothing to restore around it: refused for
+/// a cascade and remembered, so looked at again it is futile at once; a centroid on a
+/// vertex is a duplicate. Each is counted under its reason and in the total.
+#[test]
+fn refusals_are_counted_and_cascades_remembered() {
+    let (mut dom, regions) = settled_cube();
+    let t = dom
+        .dt
+        .vertex_star(0)
+        .into_iter()
+        .find(|&t| dom.dt.is_finite(t) && dom.dt.tag(t) != 0)
+        .expect("an inside tet at vertex 0");
+    let seg = *dom.subsegs.keys().min().unwrap();
+    let rb = 0.5 * dom.point(seg.0).distance(dom.point(seg.1));
+    let bad = Bad {
+        class: RATIO,
+        badness: 10.0,
+        tet: t,
+        verts: dom.dt.tet(t),
+    };
+    let (params, spacing) = (Params::default(), super::super::ConstantSpacing(10.0));
+    let mut refiner = Refiner::new(&mut dom, &params, &spacing, &regions);
+    let n = refiner.dom.dt.num_vertices();
+    let outcome = refiner
+        .refine_encroached(bad, Boundary::Segment(seg.0, seg.1), 5.0 * rb)
+        .unwrap();
+    assert_eq!(outcome, Outcome::Refused(Refusal::Cascade));
+    assert!(refiner.record(bad, outcome, n).unwrap());
+    let again = refiner.refine_tet(bad, true).unwrap();
+    assert_eq!(again, Outcome::Refused(Refusal::Futile));
+    assert!(refiner.record(bad, again, n).unwrap());
+    let on_vertex = refiner.dom.point(0);
+    let duplicate = refiner.insert_volume_point(on_vertex, 1.0, t).unwrap();
+    assert_eq!(duplicate, Outcome::Refused(Refusal::Duplicate));
+    assert!(refiner.record(bad, duplicate, n).unwrap());
+    assert_eq!(refiner.dom.dt.num_vertices(), n);
+    let r = &refiner.refusals;
+    assert_eq!((r.cascade, r.futile, r.duplicate, r.total), (1, 1, 1, 3));
+    assert!(refiner.blocked_by_small_angle.is_empty());
+}
+
+/// Tets that are flat by construction (three vertices on one segment, or four in one
+/// facet, one of them inserted) are named so; one reaching across the cube is not. (Four
+/// input vertices are exact: the predicates see their flatness.)
+#[test]
+fn flat_by_construction_names_collinear_and_coplanar_tets() {
+    let input = cube_input();
+    let mut dom = Domain::new(&input).unwrap();
+    assert_eq!(
+        dom.recover_boundary(&mut 1_000_000).unwrap(),
+        Settled::Conforming
+    );
+    let s = dom
+        .segments
+        .iter()
+        .position(|s| s.ends.contains(&0) && s.ends.contains(&1))
+        .unwrap();
+    let mid = dom.segment_split_point(0, 1);
+    let m = dom.split_subsegment(0, 1, mid, None).unwrap();
+    assert_eq!(dom.kind[m as usize], VertexKind::Segment(s as u32));
+    let f = dom.segments[s].facets[0];
+    let in_f: Vec<u32> = dom.facets[f as usize]
+        .vertices()
+        .filter(|&v| v < 8)
+        .collect();
+    assert_eq!(in_f.len(), 4);
+    let off_f = (0..8).find(|v| !in_f.contains(v)).unwrap();
+    assert!(dom.flat_by_construction([0, m, 1, off_f]));
+    assert!(dom.flat_by_construction([m, in_f[1], in_f[2], in_f[3]]));
+    let [a, b, c] = [in_f[0], in_f[1], in_f[2]];
+    assert!(!dom.flat_by_construction([a, b, c, off_f]));
+    let x = dom
+        .insert_point(DVec3::splat(0.5), VertexKind::Volume, None, None)
+        .unwrap();
+    assert!(!dom.flat_by_construction([0, m, x, off_f]));
+}
