@@ -19,6 +19,7 @@
 //! farther than the distance bound from its surface centre. Bad facets are refined largest
 //! first, each at its surface centre.
 
+mod facet_level;
 mod tracking;
 mod volume;
 
@@ -28,6 +29,7 @@ use super::curves::{Curve, FeatureCurves};
 use crate::delaunay::tables::FACE;
 use crate::delaunay::{Cavity, Delaunay, Inserted, Probe, INFINITE};
 use crate::geom::{circumcenter, tri_circumcenter};
+use crate::refine::outcome::{BoundaryKind, Outcome, Refusal};
 use crate::refine::{MeshError, Spacing};
 use crate::surface::oracle::{Crossing, SurfaceOracle};
 use crate::surface::InputSurface;
@@ -81,7 +83,7 @@ struct SubSeg {
 
 /// A face of the triangulation whose Voronoi edge crosses the surface.
 #[derive(Debug, Clone, Copy)]
-struct Restricted {
+pub(crate) struct Restricted {
     vertices: [u32; 3],
     centre: DVec3,
     radius: f64,
@@ -683,22 +685,23 @@ impl<'a> SurfaceMesher<'a> {
         }
     }
 
-    /// Inserts a facet's surface centre, or queues the subsegments it would encroach.
-    fn insert_surface_point(&mut self, r: Restricted, hint: u32, why: Bad) {
+    /// Inserts a facet's surface centre, or queues the subsegments it would encroach (and the
+    /// facet again), or says why it does neither.
+    fn insert_surface_point(&mut self, r: Restricted, hint: u32, why: Bad) -> Outcome {
         // Next to a small corner refinement would go on towards the apex (the curves alone
         // are refined there, for length and distance).
         if why != Bad::Boundary && self.near_small_corner(r.centre) {
-            return;
+            return Outcome::Refused(Refusal::NearSmallAngle);
         }
         let Probe::Cavity(cavity) = self.dt.probe(r.centre, Some(hint)) else {
-            return;
+            return Outcome::Refused(Refusal::Duplicate);
         };
         // A restricted facet's surface ball is empty. A vertex well inside it means the facet
         // was judged on ill-conditioned circumcentres (nearly flat tets of coplanar samples),
         // and its centre may sit on that vertex: two vertices 1e-16 apart, a zero-angle facet
         // and a cascade (star.off at sizes 0.05-0.3). Such a centre is not inserted.
         if self.nearest_in_cavity(&cavity) < EMPTY_BALL_FRACTION * r.radius {
-            return;
+            return Outcome::Refused(Refusal::FlatToRounding);
         }
         let encroached = self.encroached_by_cavity(&cavity);
         if !encroached.is_empty() {
@@ -707,7 +710,7 @@ impl<'a> SurfaceMesher<'a> {
             let n = self.deferrals.entry(key3(r.vertices)).or_default();
             *n += 1;
             if *n > MAX_DEFERRALS {
-                return;
+                return Outcome::Refused(Refusal::Cascade);
             }
             for k in encroached {
                 self.force_split.insert(k);
@@ -717,15 +720,16 @@ impl<'a> SurfaceMesher<'a> {
                 radius: r.radius,
                 face: key3(r.vertices),
             });
-            return;
+            return Outcome::Queued(BoundaryKind::Segment);
         }
         let Ok(Inserted::New(id)) = self.dt.insert_cavity(cavity) else {
-            return;
+            return Outcome::Refused(Refusal::Duplicate);
         };
         self.loc
             .push(Loc::Patch(self.patch_of[r.triangle as usize]));
         debug_assert_eq!(self.loc.len(), id as usize + 1);
         self.after_insertion();
+        Outcome::Split(BoundaryKind::Facet)
     }
 
     /// Distance from the probed point to the nearest vertex of its cavity (its nearest vertex).

@@ -4,16 +4,17 @@
 
 mod domain;
 pub mod existing;
+pub(crate) mod levels;
 mod mark;
-mod outcome;
+pub(crate) mod outcome;
 mod output;
+mod plc_level;
 mod quality;
 mod recover;
 pub mod report;
 mod spacing;
 
 pub use outcome::Refusals;
-pub(crate) use quality::random_in_unit_ball;
 pub use spacing::AutoSpacing;
 
 use crate::mesh::TetMesh;

@@ -1,14 +1,17 @@
-//! What refining one bad tet did (`Refiner::refine_tet` decides, `Refiner::run` keeps the
+//! What refining one bad element did (`Refiner::refine_tet` decides, `Refiner::run` keeps the
 //! books), and the count of bad tets left alone per reason that the report carries.
 
 /// What refining one bad tet did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum Outcome {
+pub(crate) enum Outcome {
     /// A volume vertex was inserted: a point of its picking ball, or its centroid.
     Inserted,
     /// A boundary element of this kind was split instead (one the chosen point encroached, or
     /// the subsegment a subfacet's centre encroached).
     Split(BoundaryKind),
+    /// The encroached boundary element was queued at its level, which refines it before the
+    /// element that asked is looked at again (the approximate mode's subsegments).
+    Queued(BoundaryKind),
     /// Restoring the boundary around it split something; it is looked at again if it survived.
     Resettled,
     /// Put aside until every other bad tet is handled.
@@ -21,7 +24,7 @@ pub(super) enum Outcome {
 
 /// A kind of boundary element.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum BoundaryKind {
+pub(crate) enum BoundaryKind {
     Segment,
     Facet,
 }
@@ -29,7 +32,7 @@ pub(super) enum BoundaryKind {
 /// Why a bad tet was left as it is (the comment where each is produced says why nothing else
 /// helps there).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum Refusal {
+pub(crate) enum Refusal {
     /// Refused with [`Refusal::Cascade`] or [`Refusal::CascadeNearSmallAngle`] before, and
     /// looked at again: left at once.
     Futile,

@@ -11,12 +11,14 @@
 //!
 //! Which cells are inside and which facets are restricted is kept up to date by `tracking`.
 
-use super::{key3, Bad, Loc, Restricted, SurfaceMesher};
+use super::facet_level::Encroached;
+use super::{Loc, SurfaceMesher};
 use crate::delaunay::tables::FACE;
-use crate::delaunay::{BoundaryFace, Cavity, Inserted, Probe, INFINITE};
+use crate::delaunay::{Inserted, Probe, INFINITE};
 use crate::geom::circumsphere;
-use crate::geom::screen::{shortest_edge_sq, sliver_measures, SliverScreen};
-use crate::refine::{random_in_unit_ball, AutoSpacing, Spacing};
+use crate::geom::screen::{shortest_edge_sq, sliver_measures};
+use crate::refine::levels::{pick_in_ball, Conflict, FacetLevel, Picker, Request, SliverBounds};
+use crate::refine::{AutoSpacing, Spacing};
 use glam::DVec3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -52,9 +54,9 @@ const MAX_CELL_DEFERRALS: u8 = 4;
 
 pub(super) struct VolumeState {
     crit: VolumeCriteria,
-    cos_min_dihedral: f64,
-    /// Clears most new tets from squared measures alone (`geom::screen`).
-    screen: SliverScreen,
+    slivers: SliverBounds,
+    /// Li's point choice (small slivers, random draws); None while lent out.
+    picker: Option<Picker>,
     queues: [VecDeque<(u32, [u32; 4])>; 3],
     deferrals: FxHashMap<[u32; 4], u8>,
     pub(super) spacing: Option<AutoSpacing>,
@@ -62,14 +64,6 @@ pub(super) struct VolumeState {
     near_small: Vec<bool>,
     /// The caller's progress callback asked to stop.
     cancelled: bool,
-    rng: ChaCha8Rng,
-}
-
-/// What a refinement point would break.
-enum Encroached {
-    Nothing,
-    Facet(Restricted, u32),
-    Subsegments(Vec<[u32; 2]>),
 }
 
 impl VolumeState {
@@ -84,14 +78,20 @@ impl SurfaceMesher<'_> {
         let spacing = (!crit.user_spacing).then(|| self.surface_sizes(faces));
         self.vol = Some(Box::new(VolumeState {
             crit,
-            cos_min_dihedral: crit.min_dihedral_deg.to_radians().cos(),
-            screen: SliverScreen::new(crit.sigma0, crit.min_dihedral_deg),
+            slivers: SliverBounds::new(crit.sigma0, crit.min_dihedral_deg),
+            picker: Some(Picker::new(
+                ChaCha8Rng::seed_from_u64(crit.seed ^ 0x766f_6c75_6d65),
+                crit.delta,
+                crit.max_tries,
+                crit.b,
+                crit.sigma0,
+                crit.min_dihedral_deg,
+            )),
             queues: Default::default(),
             deferrals: FxHashMap::default(),
             spacing,
             near_small: vec![],
             cancelled: false,
-            rng: ChaCha8Rng::seed_from_u64(crit.seed ^ 0x766f_6c75_6d65),
         }));
         self.mark_near_small_corners();
         let tets: Vec<u32> = self.dt.finite_tet_ids().collect();
@@ -189,7 +189,7 @@ impl SurfaceMesher<'_> {
             return Some(RATIO);
         }
         let (sigma, max_cos) = sliver_measures(a, b, c, d, l2);
-        (sigma < vol.crit.sigma0 || max_cos > vol.cos_min_dihedral).then_some(SLIVER)
+        vol.slivers.is_sliver(sigma, max_cos).then_some(SLIVER)
     }
 
     /// The next bad cell still present, largest class first.
@@ -245,14 +245,20 @@ impl SurfaceMesher<'_> {
         let Probe::Cavity(cavity) = self.dt.probe(centre, Some(t)) else {
             return;
         };
-        match self.encroached_by_cell_point(&cavity) {
-            Encroached::Nothing => {}
-            encroached => {
-                self.refine_encroached(t, tv, encroached);
-                return;
-            }
+        match self.conflict(&cavity, r, Request::Shape) {
+            Conflict::Free => {}
+            Conflict::Encroaches(e) => return self.yield_to_surface(t, tv, e),
+            Conflict::Refused(_) => return,
         }
-        let cavity = self.pick_point(t, cavity, r);
+        let Some(mut picker) = self.lend_picker() else {
+            return;
+        };
+        let centre = cavity.point();
+        let picked = pick_in_ball(self, &mut picker, centre, Some(cavity), r, t);
+        self.return_picker(picker);
+        let Some(cavity) = picked else {
+            return;
+        };
         if let Ok(Inserted::New(id)) = self.dt.insert_cavity(cavity) {
             self.loc.push(Loc::Volume);
             debug_assert_eq!(self.loc.len(), id as usize + 1);
@@ -260,18 +266,17 @@ impl SurfaceMesher<'_> {
         }
     }
 
-    /// The surface or a subsegment is refined for cell `t` instead of it; the cell waits (a
-    /// limited number of times: next to a refusing facet it is left).
-    fn refine_encroached(&mut self, t: u32, tv: [u32; 4], encroached: Encroached) {
-        match encroached {
-            Encroached::Nothing => return,
-            Encroached::Facet(r, hint) => self.insert_surface_point(r, hint, Bad::Size),
-            Encroached::Subsegments(keys) => {
-                for k in keys {
-                    self.force_split.insert(k);
-                    self.seg_queue.push(k);
-                }
-            }
+    /// The surface or a subsegment is refined for cell `t` instead of it (the facet level
+    /// refines the facet now or queues the subsegments); the cell waits (a limited number of
+    /// times: next to a refusing facet it is left).
+    fn yield_to_surface(&mut self, t: u32, tv: [u32; 4], encroached: Encroached) {
+        let Some(mut picker) = self.lend_picker() else {
+            return;
+        };
+        let outcome = self.refine_encroached(encroached, &mut picker);
+        self.return_picker(picker);
+        if outcome.is_err() {
+            return;
         }
         let Some(vol) = self.vol.as_mut() else {
             return;
@@ -288,120 +293,14 @@ impl SurfaceMesher<'_> {
         }
     }
 
-    /// What inserting probed point p would break: a restricted facet whose surface ball holds
-    /// p (the largest), else feature subsegments whose diametric ball does.
-    fn encroached_by_cell_point(&self, probed: &Cavity) -> Encroached {
-        if self.vol.is_none() {
-            return Encroached::Nothing;
-        }
-        let p = probed.point();
-        let (cavity, _) = self.dt.cavity(probed);
-        let on_surface =
-            |v: u32| v != INFINITE && !matches!(self.loc[v as usize], Loc::Volume | Loc::Far);
-        let mut best: Option<([u32; 3], f64, u32)> = None;
-        for &t in cavity {
-            let tv = self.dt.tet(t);
-            let n_surface = tv.iter().filter(|&&v| on_surface(v)).count();
-            if n_surface < 3 {
-                continue;
-            }
-            for f in FACE {
-                let face = f.map(|k| tv[k]);
-                if !face.iter().all(|&v| on_surface(v)) {
-                    continue;
-                }
-                let key = key3(face);
-                if let Some(&(centre, radius, _)) = self.track.restricted.get(&key) {
-                    if (p - centre).length_squared() < radius * radius
-                        && best.is_none_or(|b| radius > b.1)
-                    {
-                        best = Some((key, radius, t));
-                    }
-                }
-            }
-        }
-        if let Some((key, _, t)) = best {
-            if let Some([(ft, i), _]) = self.dt.find_face(key[0], key[1], key[2]) {
-                if let Some(r) = self.facet_at(ft, i) {
-                    return Encroached::Facet(r, t);
-                }
-            }
-        }
-        let segs = self.encroached_by_cavity(probed);
-        if segs.is_empty() {
-            Encroached::Nothing
-        } else {
-            Encroached::Subsegments(segs)
-        }
+    /// The cell level's picker, lent to a level function that takes the mesher too.
+    fn lend_picker(&mut self) -> Option<Picker> {
+        self.vol.as_mut()?.picker.take()
     }
 
-    /// Li's choice: the circumcentre if it creates no small sliver, else the point of the
-    /// picking ball (radius delta r) creating the fewest, among those that break nothing.
-    /// Takes and returns probes (the chosen one is current when it was the last drawn).
-    fn pick_point(&mut self, t: u32, centre: Cavity, r: f64) -> Cavity {
-        let Some(crit) = self.vol.as_ref().map(|v| v.crit) else {
-            return centre;
-        };
-        let score = self.small_slivers(&centre, crit.b * r, usize::MAX);
-        if score.0 == 0 {
-            return centre;
+    fn return_picker(&mut self, picker: Picker) {
+        if let Some(vol) = self.vol.as_mut() {
+            vol.picker = Some(picker);
         }
-        let c = centre.point();
-        let mut best = (score, centre);
-        for _ in 0..crit.max_tries {
-            let q = c + self.random_in_ball() * (crit.delta * r);
-            let Probe::Cavity(cavity) = self.dt.probe(q, Some(t)) else {
-                continue;
-            };
-            let score = self.small_slivers(&cavity, crit.b * r, best.0 .0);
-            if score >= best.0 {
-                continue;
-            }
-            if !matches!(self.encroached_by_cell_point(&cavity), Encroached::Nothing) {
-                continue;
-            }
-            best = (score, cavity);
-            if score.0 == 0 {
-                break;
-            }
-        }
-        best.1
-    }
-
-    fn random_in_ball(&mut self) -> DVec3 {
-        self.vol
-            .as_mut()
-            .map_or(DVec3::ZERO, |vol| random_in_unit_ball(&mut vol.rng))
-    }
-
-    /// The small slivers (circumradius <= `max_r`) inserting probed point p would create,
-    /// and the largest cosine of a smallest dihedral angle among them; the count stops once it
-    /// passes `enough` (the point is then no better than one already found).
-    fn small_slivers(&self, cavity: &Cavity, max_r: f64, enough: usize) -> (usize, f64) {
-        let Some(vol) = self.vol.as_ref() else {
-            return (0, -1.0);
-        };
-        let p = cavity.point();
-        let (_, faces) = self.dt.cavity(cavity);
-        let points = self.dt.points();
-        let corners = |f: &BoundaryFace| {
-            let v = f.vertices();
-            (!v.contains(&INFINITE)).then(|| v.map(|v| points[v as usize]))
-        };
-        let mut n = 0;
-        let mut worst = -1.0f64;
-        vol.screen
-            .for_each_uncleared(faces, corners, p, |[x, y, z]| {
-                let l2 = shortest_edge_sq(x, y, z, p);
-                let (sigma, max_cos) = sliver_measures(x, y, z, p, l2);
-                if (sigma < vol.crit.sigma0 || max_cos > vol.cos_min_dihedral)
-                    && circumsphere(x, y, z, p).is_none_or(|s| s.1 <= max_r)
-                {
-                    n += 1;
-                    worst = worst.max(max_cos);
-                }
-                n <= enough
-            });
-        (n, worst)
     }
 }

@@ -67,7 +67,7 @@ fn cube_with_unsettled_subsegment() -> (Domain, Regions, u32) {
     (dom, regions, t)
 }
 
-/// The stale-element case of `refine_encroached`: a bad tet's centre encroaches a
+/// The stale-element case of `yield_to_boundary`: a bad tet's centre encroaches a
 /// subsegment much smaller than the tet, so the boundary around the tet is restored first
 /// (`resettle_or_refuse`). When that split the very subsegment, the element found before the
 /// change is gone and must not be split again: it used to be, which failed with an
@@ -97,10 +97,13 @@ fn encroached_element_gone_after_resettling_is_not_split() {
         verts: dom.dt.tet(t),
     };
     let mut refiner = Refiner::new(&mut dom, &params, &spacing, &regions);
+    let conflict = refiner
+        .dom
+        .judge(Boundary::Segment(0, 1), 20.0 * 0.5, Request::Shape);
     let outcome = refiner
-        .refine_encroached(bad, Boundary::Segment(0, 1), 20.0 * 0.5)
+        .yield_to_boundary(bad.tet, conflict)
         .expect("no split of a subsegment that is gone");
-    assert_eq!(outcome, Outcome::Resettled);
+    assert_eq!(outcome, Some(Outcome::Resettled));
     assert_eq!(dom.dt.num_vertices(), expected);
 }
 
@@ -128,9 +131,10 @@ fn refusals_are_counted_and_cascades_remembered() {
     let (params, spacing) = (Params::default(), super::super::ConstantSpacing(10.0));
     let mut refiner = Refiner::new(&mut dom, &params, &spacing, &regions);
     let n = refiner.dom.dt.num_vertices();
-    let outcome = refiner
-        .refine_encroached(bad, Boundary::Segment(seg.0, seg.1), 5.0 * rb)
-        .unwrap();
+    let conflict = refiner
+        .dom
+        .judge(Boundary::Segment(seg.0, seg.1), 5.0 * rb, Request::Shape);
+    let outcome = refiner.yield_to_boundary(t, conflict).unwrap().unwrap();
     assert_eq!(outcome, Outcome::Refused(Refusal::Cascade));
     assert!(refiner.record(bad, outcome, n).unwrap());
     let again = refiner.refine_tet(bad, true).unwrap();
@@ -180,4 +184,82 @@ fn flat_by_construction_names_collinear_and_coplanar_tets() {
         .insert_point(DVec3::splat(0.5), VertexKind::Volume, None, None)
         .unwrap();
     assert!(!dom.flat_by_construction([0, m, x, off_f]));
+}
+
+/// Keep mode's facet level, through the interface the cell level uses, on the unit cube
+/// refined to spacing 0.3: a point well inside breaks nothing; a point just above the middle
+/// of the bottom facet encroaches a subfacet there, and the policy decides by the request and
+/// the asking tet's size. Refining that subfacet splits it and leaves the boundary conforming;
+/// Li's choice in a ball around an inside point keeps a point that breaks nothing.
+#[test]
+fn plc_facet_level_conflicts_follow_the_request() {
+    use super::super::levels::pick_in_ball;
+    let (mut dom, regions) = settled_cube();
+    let params = Params::default();
+    let spacing = super::super::ConstantSpacing(0.3);
+    Refiner::new(&mut dom, &params, &spacing, &regions)
+        .run(&mut |_| true)
+        .unwrap();
+    let probe = |dom: &mut Domain, p: DVec3| match dom.dt.probe(p, None) {
+        Probe::Cavity(c) => c,
+        Probe::Duplicate(_) => panic!("a vertex at {p}"),
+    };
+    let all = [
+        Request::Shape,
+        Request::ShapeNearSmallAngle,
+        Request::SizeNearSmallAngle,
+    ];
+    let inside = DVec3::new(0.45, 0.52, 0.48);
+    let inside_cavity = probe(&mut dom, inside);
+    for request in all {
+        let conflict = dom.conflict(&inside_cavity, 0.2, request);
+        assert!(matches!(conflict, Conflict::Free), "{conflict:?}");
+    }
+    let low = probe(&mut dom, DVec3::new(0.5, 0.5, 1e-3));
+    let Some(b @ Boundary::Facet(_, t)) = dom.encroached(&low) else {
+        panic!("no subfacet encroached");
+    };
+    let [x, y, z] = t.map(|v| dom.point(v));
+    let rb = crate::geom::equatorial_ball(x, y, z).unwrap().1;
+    let verdict = |r: f64, request| format!("{:?}", dom.conflict(&low, r, request));
+    assert_eq!(
+        verdict(2.0 * rb, Request::Shape),
+        format!("Encroaches({b:?})")
+    );
+    assert_eq!(verdict(10.0 * rb, Request::Shape), "Refused(Cascade)");
+    assert_eq!(
+        verdict(2.0 * rb, Request::ShapeNearSmallAngle),
+        "Refused(NearSmallAngle)"
+    );
+    assert_eq!(
+        verdict(2.0 * rb, Request::SizeNearSmallAngle),
+        format!("Encroaches({b:?})")
+    );
+    assert_eq!(
+        verdict(10.0 * rb, Request::SizeNearSmallAngle),
+        "Refused(CentroidCascade)"
+    );
+    let rng = rand::SeedableRng::seed_from_u64(1);
+    let mut picker = Picker::new(rng, params.delta, 20, params.b, params.sigma0, 15.0);
+    let n = dom.dt.num_vertices();
+    let outcome = dom.refine_encroached(b, &mut picker).unwrap();
+    assert!(matches!(outcome, Outcome::Split(_)), "{outcome:?}");
+    assert!(dom.dt.num_vertices() > n);
+    assert!(dom.dirty_segs.is_empty() && dom.dirty_tris.is_empty());
+    let before = dom.dt.num_vertices();
+    assert_eq!(
+        dom.recover_boundary(&mut 1_000_000).unwrap(),
+        Settled::Conforming
+    );
+    assert_eq!(
+        dom.dt.num_vertices(),
+        before,
+        "the split left it conforming"
+    );
+    let inside_cavity = probe(&mut dom, inside);
+    let t = dom.dt.locate_point(inside, None);
+    let chosen = pick_in_ball(&mut dom, &mut picker, inside, Some(inside_cavity), 0.2, t);
+    let chosen = chosen.expect("a point that breaks nothing");
+    assert!(chosen.point().distance(inside) <= params.delta * 0.2);
+    assert!(dom.encroached(&chosen).is_none());
 }
