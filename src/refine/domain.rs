@@ -5,7 +5,7 @@
 use super::MeshError;
 use crate::cdt::{Change, FacetMesh};
 use crate::delaunay::{Cavity, Delaunay, Inserted};
-use crate::plc::PlcInput;
+use crate::plc::{Plc, PlcInput};
 use glam::DVec3;
 use rustc_hash::{FxHashMap, FxHashSet};
 
@@ -95,8 +95,9 @@ pub fn tri_key(t: [u32; 3]) -> [u32; 3] {
 }
 
 impl Domain {
-    /// Triangulates the input vertices and sets up segments and facet triangulations.
-    pub fn new(input: &PlcInput) -> Result<Domain, MeshError> {
+    /// Triangulates the input vertices and sets up the segments (the checked PLC's, in its
+    /// numbering) and the facet triangulations.
+    pub fn new(input: &PlcInput, plc: &Plc) -> Result<Domain, MeshError> {
         let (mut dt, stats) = Delaunay::from_points(&input.vertices)
             .map_err(|e| MeshError::InvalidInput(e.to_string()))?;
         if stats.duplicates > 0 {
@@ -106,30 +107,21 @@ impl Domain {
             )));
         }
         dt.enable_tags();
-        let mut segments: Vec<Segment> = vec![];
-        let mut seg_index: FxHashMap<(u32, u32), u32> = FxHashMap::default();
+        let segments: Vec<Segment> = plc
+            .segments
+            .iter()
+            .map(|s| Segment {
+                ends: s.vertices,
+                facets: s.facets.clone(),
+            })
+            .collect();
+        let seg_index: FxHashMap<(u32, u32), u32> = (segments.iter().enumerate())
+            .map(|(i, s)| (seg_key(s.ends[0], s.ends[1]), i as u32))
+            .collect();
         let mut facets = Vec::with_capacity(input.facets.len());
         let mut markers = vec![];
         let mut subfacets = FxHashMap::default();
         for (fi, f) in input.facets.iter().enumerate() {
-            let loops = f.polygons.iter().chain(f.hole_polygons.iter());
-            // A one-vertex polygon is a lone point: no segment.
-            for poly in loops.filter(|p| p.len() > 1) {
-                for k in 0..poly.len() {
-                    let key = seg_key(poly[k], poly[(k + 1) % poly.len()]);
-                    let s = *seg_index.entry(key).or_insert_with(|| {
-                        segments.push(Segment {
-                            ends: [key.0, key.1],
-                            facets: vec![],
-                        });
-                        (segments.len() - 1) as u32
-                    });
-                    let facets_of = &mut segments[s as usize].facets;
-                    if !facets_of.contains(&(fi as u32)) {
-                        facets_of.push(fi as u32);
-                    }
-                }
-            }
             let fm = FacetMesh::new(
                 &input.vertices,
                 &f.polygons,
@@ -187,22 +179,11 @@ impl Domain {
         {
             self.small_angle_vertices.insert(a.vertex);
         }
-        let index: FxHashMap<(u32, u32), u32> = self
-            .segments
-            .iter()
-            .enumerate()
-            .map(|(i, s)| (seg_key(s.ends[0], s.ends[1]), i as u32))
-            .collect();
-        for a in acute
-            .dihedral_angles
-            .iter()
-            .filter(|a| a.degrees < SMALL_ANGLE_DEG)
-        {
-            let v = plc.segments[a.segment].vertices;
-            if let Some(&s) = index.get(&seg_key(v[0], v[1])) {
-                self.acute_segments.insert(s);
-            }
-        }
+        self.acute_segments.extend(
+            (acute.dihedral_angles.iter())
+                .filter(|a| a.degrees < SMALL_ANGLE_DEG)
+                .map(|a| a.segment as u32),
+        );
         for &s in &self.acute_segments {
             self.acute_facets
                 .extend(self.segments[s as usize].facets.iter().copied());

@@ -443,7 +443,7 @@ fn mesh_domain(
     let start = std::time::Instant::now();
     params.check().map_err(MeshError::InvalidInput)?;
     let plc = crate::plc::validate(input).map_err(|e| MeshError::InvalidInput(e.to_string()))?;
-    let mut dom = domain::Domain::new(input)?;
+    let mut dom = domain::Domain::new(input, &plc)?;
     match small_angles {
         SmallAngles::Input => dom.set_acute_angles(&plc, params.small_angle_reach),
         SmallAngles::None => {}

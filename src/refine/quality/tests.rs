@@ -34,7 +34,7 @@ fn cube_input() -> crate::plc::PlcInput {
 fn settled_cube() -> (Domain, Regions) {
     let input = cube_input();
     let plc = crate::plc::validate(&input).unwrap();
-    let mut dom = Domain::new(&input).unwrap();
+    let mut dom = Domain::new(&input, &plc).unwrap();
     dom.set_acute_angles(&plc, f64::INFINITY);
     assert_eq!(
         dom.recover_boundary(&mut 1_000_000).unwrap(),
@@ -156,7 +156,8 @@ fn refusals_are_counted_and_cascades_remembered() {
 #[test]
 fn flat_by_construction_names_collinear_and_coplanar_tets() {
     let input = cube_input();
-    let mut dom = Domain::new(&input).unwrap();
+    let plc = crate::plc::validate(&input).unwrap();
+    let mut dom = Domain::new(&input, &plc).unwrap();
     assert_eq!(
         dom.recover_boundary(&mut 1_000_000).unwrap(),
         Settled::Conforming
