@@ -46,11 +46,11 @@ pub struct Domain {
     pub small_angle_vertices: FxHashSet<u32>,
     /// Input segments (indices into `segments`) between two facets meeting at less than
     /// SMALL_ANGLE_DEG: the whole segment is a small angle.
-    pub acute_segments: FxHashSet<u32>,
-    /// Input facets around an acute segment.
-    pub acute_facets: FxHashSet<u32>,
-    /// Per vertex: within the influence of a small input angle (see `near_acute`).
-    near_small_angle: Vec<bool>,
+    pub small_angle_segments: FxHashSet<u32>,
+    /// Input facets around a small-angle segment.
+    pub small_angle_facets: FxHashSet<u32>,
+    /// Per vertex: within the influence of a small input angle (see `near_small_angle`).
+    near_small: Vec<bool>,
     /// `Params::small_angle_reach`.
     small_angle_reach: f64,
     /// Protecting balls around the acute input vertices: vertex -> radius. Inside one,
@@ -73,8 +73,10 @@ pub struct Domain {
 }
 
 /// Input angles below this (between segments at a vertex, or between facets at a segment) are
-/// "small": refinement does not enforce shape bounds next to them. Angles between 60 and 90
-/// degrees are acute too, but refinement terminates around them in practice (Shewchuk).
+/// "small": refinement does not enforce shape bounds next to them (`near_small_angle`).
+/// "Acute" means below 90 degrees and matters only for segments meeting at a vertex: those get
+/// a protecting ball and concentric-shell splits (`acute_vertices`); an acute angle that is
+/// not small needs nothing more, since refinement terminates around it in practice (Shewchuk).
 pub const SMALL_ANGLE_DEG: f64 = 60.0;
 
 /// Protecting-ball radius as a fraction of the distance from an acute vertex to its nearest
@@ -135,7 +137,7 @@ impl Domain {
             facets.push(fm);
             markers.push(f.marker);
         }
-        let acute_vertices = acute_segment_vertices(&input.vertices, &segments);
+        let acute_vertices = acute_vertices_of(&input.vertices, &segments);
         Ok(Domain {
             dt,
             kind: vec![VertexKind::Input; input.vertices.len()],
@@ -149,9 +151,9 @@ impl Domain {
             subfacets,
             acute_vertices,
             small_angle_vertices: FxHashSet::default(),
-            acute_segments: FxHashSet::default(),
-            acute_facets: FxHashSet::default(),
-            near_small_angle: vec![false; input.vertices.len()],
+            small_angle_segments: FxHashSet::default(),
+            small_angle_facets: FxHashSet::default(),
+            near_small: vec![false; input.vertices.len()],
             small_angle_reach: f64::INFINITY,
             dirty_segs: vec![],
             dirty_tris: vec![],
@@ -160,10 +162,10 @@ impl Domain {
         })
     }
 
-    /// Records the small input angles the validator found (see `near_acute`) and puts a
+    /// Records the small input angles the validator found (see `near_small_angle`) and puts a
     /// protecting ball around every acute input vertex (see `protect_radius`). Not called for
     /// the boundary of an existing mesh, whose angles are not features.
-    pub fn set_acute_angles(&mut self, plc: &crate::plc::Plc, reach: f64) {
+    pub fn set_input_angles(&mut self, plc: &crate::plc::Plc, reach: f64) {
         self.small_angle_reach = reach;
         for &v in &self.acute_vertices {
             let r = PROTECT_FRACTION * nearest_neighbor_distance(&self.dt, v);
@@ -179,13 +181,13 @@ impl Domain {
         {
             self.small_angle_vertices.insert(a.vertex);
         }
-        self.acute_segments.extend(
+        self.small_angle_segments.extend(
             (acute.dihedral_angles.iter())
                 .filter(|a| a.degrees < SMALL_ANGLE_DEG)
                 .map(|a| a.segment as u32),
         );
-        for &s in &self.acute_segments {
-            self.acute_facets
+        for &s in &self.small_angle_segments {
+            self.small_angle_facets
                 .extend(self.segments[s as usize].facets.iter().copied());
         }
         self.mark_near_small_angles();
@@ -203,14 +205,14 @@ impl Domain {
         }
     }
 
-    /// Computes `near_acute` for every vertex present.
+    /// Computes `near_small_angle` for every vertex present.
     fn mark_near_small_angles(&mut self) {
-        self.near_small_angle = (0..self.kind.len() as u32)
+        self.near_small = (0..self.kind.len() as u32)
             .map(|v| self.is_near_small_angle(v, self.point(v), self.kind[v as usize]))
             .collect();
     }
 
-    /// See `near_acute`; for a vertex `v` at `p` of kind `kind` (its apex already recorded).
+    /// See `near_small_angle`; for a vertex `v` at `p` of kind `kind` (its apex already recorded).
     fn is_near_small_angle(&self, v: u32, p: DVec3, kind: VertexKind) -> bool {
         let apex = self.apex[v as usize];
         if apex != NO_APEX && self.small_angle_vertices.contains(&apex) {
@@ -228,11 +230,12 @@ impl Domain {
         match kind {
             VertexKind::Input => self.small_angle_vertices.contains(&v),
             VertexKind::Segment(s) => {
-                self.acute_segments.contains(&s)
+                self.small_angle_segments.contains(&s)
                     || self.segments[s as usize].ends.iter().any(reaches)
             }
             VertexKind::Facet(f) => {
-                self.acute_facets.contains(&f) || self.facet_apexes[f as usize].iter().any(reaches)
+                self.small_angle_facets.contains(&f)
+                    || self.facet_apexes[f as usize].iter().any(reaches)
             }
             VertexKind::Volume => false,
         }
@@ -244,8 +247,8 @@ impl Domain {
     /// facets meeting at a small angle or on one of those facets, or on a segment or facet
     /// holding a small-angle vertex and within `Params::small_angle_reach` protecting-ball
     /// radii of it (computed once per vertex, when it is inserted).
-    pub fn near_acute(&self, v: u32) -> bool {
-        self.near_small_angle[v as usize]
+    pub fn near_small_angle(&self, v: u32) -> bool {
+        self.near_small[v as usize]
     }
 
     /// Whether tet `verts` is flat by construction: three of its vertices lie on one input
@@ -302,25 +305,25 @@ impl Domain {
     }
 
     /// Whether vertex `v` is within the influence of an acute input angle: next to a small
-    /// one (`near_acute`) or in the protecting ball of an acute input vertex, where boundary
+    /// one (`near_small_angle`) or in the protecting ball of an acute input vertex, where boundary
     /// elements may stay encroached.
     pub fn influenced_by_acute_angle(&self, v: u32) -> bool {
-        self.near_acute(v) || self.apex[v as usize] != NO_APEX
+        self.near_small_angle(v) || self.apex[v as usize] != NO_APEX
     }
 
     /// Whether the boundary element with vertices `verts` is exempt from splitting for
     /// encroachment alone during boundary recovery: all of them lie in one protecting ball
-    /// (see `protect_radius`), or it is near a small angle (`near_acute_element`).
+    /// (see `protect_radius`), or it is near a small angle (`near_small_angle_element`).
     pub fn protected(&self, verts: &[u32]) -> bool {
         let a = self.apex[verts[0] as usize];
         (a != NO_APEX && verts.iter().all(|&v| self.apex[v as usize] == a))
-            || self.near_acute_element(verts)
+            || self.near_small_angle_element(verts)
     }
 
     /// Whether a boundary element with vertices `verts` touches a feature with a small angle,
     /// where quality is not enforced and splits would encroach each other without end.
-    pub fn near_acute_element(&self, verts: &[u32]) -> bool {
-        verts.iter().any(|&v| self.near_acute(v))
+    pub fn near_small_angle_element(&self, verts: &[u32]) -> bool {
+        verts.iter().any(|&v| self.near_small_angle(v))
     }
 
     pub fn point(&self, v: u32) -> DVec3 {
@@ -346,7 +349,7 @@ impl Domain {
                 self.kind.push(kind);
                 self.apex.push(apex);
                 let near = self.is_near_small_angle(id, p, kind);
-                self.near_small_angle.push(near);
+                self.near_small.push(near);
                 self.queue_around_last_insertion();
                 self.created_log.extend_from_slice(self.dt.last_created());
                 self.boundary_inserted |= kind != VertexKind::Volume;
@@ -493,7 +496,7 @@ fn nearest_neighbor_distance(dt: &Delaunay, v: u32) -> f64 {
 }
 
 /// Input vertices where two segments meet at less than 90 degrees.
-fn acute_segment_vertices(points: &[DVec3], segments: &[Segment]) -> FxHashSet<u32> {
+fn acute_vertices_of(points: &[DVec3], segments: &[Segment]) -> FxHashSet<u32> {
     let mut around: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
     for s in segments {
         around.entry(s.ends[0]).or_default().push(s.ends[1]);

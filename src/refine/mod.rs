@@ -445,7 +445,7 @@ fn mesh_domain(
     let plc = crate::plc::validate(input).map_err(|e| MeshError::InvalidInput(e.to_string()))?;
     let mut dom = domain::Domain::new(input, &plc)?;
     match small_angles {
-        SmallAngles::Input => dom.set_acute_angles(&plc, params.small_angle_reach),
+        SmallAngles::Input => dom.set_input_angles(&plc, params.small_angle_reach),
         SmallAngles::None => {}
     }
     let mut budget = recover::MAX_RECOVERY_SPLITS.min(params.max_vertices.saturating_mul(4));

@@ -172,11 +172,11 @@ impl Domain {
     }
 
     /// Whether refinement must not split boundary element `b`: it touches a small input
-    /// angle (`Domain::near_acute_element`).
+    /// angle (`Domain::near_small_angle_element`).
     fn is_protected(&self, b: Boundary) -> bool {
         match b {
-            Boundary::Segment(a, c) => self.near_acute_element(&[a, c]),
-            Boundary::Facet(_, t) => self.near_acute_element(&t),
+            Boundary::Segment(a, c) => self.near_small_angle_element(&[a, c]),
+            Boundary::Facet(_, t) => self.near_small_angle_element(&t),
         }
     }
 

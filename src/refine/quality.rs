@@ -176,7 +176,7 @@ impl<'a> Refiner<'a> {
                 verts,
             })
         };
-        let near = verts.iter().any(|&v| self.dom.near_acute(v));
+        let near = verts.iter().any(|&v| self.dom.near_small_angle(v));
         if near {
             // Next to a small input angle size is measured by the longest edge: the tets there
             // may stay flat, and a flat tet's circumradius says nothing about its size.
@@ -354,7 +354,7 @@ impl<'a> Refiner<'a> {
             // restoring the boundary around it may; else the improvement removes it.
             return self.resettle_or_refuse(bad.tet, Refusal::FlatByConstruction);
         }
-        let near = bad.verts.iter().any(|&v| self.dom.near_acute(v));
+        let near = bad.verts.iter().any(|&v| self.dom.near_small_angle(v));
         let [a, b, c, d] = self.dom.dt.tet_points(bad.tet);
         if near && bad.class == SIZE {
             // Size-bad next to a small angle (see `classify`): split at the centroid, which

@@ -5,13 +5,13 @@ use crate::geom::TetQuality;
 use crate::mesh::TetMesh;
 
 /// Measures `mesh` (tets only; timings and completion are filled in by the caller). Tets that
-/// miss a bound of `params` are counted in `n_bad_near_acute` when `near_acute(tet)` says so;
+/// miss a bound of `params` are counted in `n_bad_near_acute` when `near_small_angle(tet)` says so;
 /// the others are returned.
 pub fn measure(
     mesh: &TetMesh,
     spacing: &dyn Spacing,
     params: &Params,
-    near_acute: &dyn Fn(&[u32; 4]) -> bool,
+    near_small_angle: &dyn Fn(&[u32; 4]) -> bool,
 ) -> Result<(Report, usize), MeshError> {
     let mut bad_elsewhere = 0;
     let mut r = Report {
@@ -38,7 +38,7 @@ pub fn measure(
         r.min_dihedral_deg = r.min_dihedral_deg.min(q.min_dihedral);
         r.max_dihedral_deg = r.max_dihedral_deg.max(q.max_dihedral);
         if q.rho > params.rho0 || q.sigma < params.sigma0 || q.min_dihedral < params.min_dihedral {
-            if near_acute(t) {
+            if near_small_angle(t) {
                 r.n_bad_near_acute += 1;
             } else {
                 bad_elsewhere += 1;

@@ -35,7 +35,7 @@ fn settled_cube() -> (Domain, Regions) {
     let input = cube_input();
     let plc = crate::plc::validate(&input).unwrap();
     let mut dom = Domain::new(&input, &plc).unwrap();
-    dom.set_acute_angles(&plc, f64::INFINITY);
+    dom.set_input_angles(&plc, f64::INFINITY);
     assert_eq!(
         dom.recover_boundary(&mut 1_000_000).unwrap(),
         Settled::Conforming
