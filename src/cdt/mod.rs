@@ -757,6 +757,16 @@ impl FacetMesh {
     /// constrained Delaunay (no apex strictly inside across a non-constrained facet edge), and
     /// the facet's area against the polygons' area (relative 1e-9; see the module limits).
     pub fn validate(&self) -> Result<(), String> {
+        self.validate_with(true)
+    }
+
+    /// [`Self::validate`] without the constrained Delaunay property: what must hold after
+    /// [`Self::flip`] took a diagonal the 3D triangulation chose (refinement matches it).
+    pub fn validate_structure(&self) -> Result<(), String> {
+        self.validate_with(false)
+    }
+
+    fn validate_with(&self, delaunay: bool) -> Result<(), String> {
         let (nv, nt) = (self.gid.len(), self.tris.len());
         ensure!(nt == 2 * nv - 5, "{nt} triangles for {nv} vertices");
         let mut n_in = 0;
@@ -785,7 +795,7 @@ impl FacetMesh {
                 ensure!(ok, "unconstrained boundary {t}|{u}");
                 let ok = !cons || inside || ur.inside();
                 ensure!(ok, "constrained edge {t}|{u} outside");
-                let bad = inside && !cons && self.incircle(tr.v[i], x, y, ur.v[j]);
+                let bad = delaunay && inside && !cons && self.incircle(tr.v[i], x, y, ur.v[j]);
                 let d = self.gid[ur.v[j] as usize];
                 ensure!(!bad, "{d} in the circle of {g:?}");
             }

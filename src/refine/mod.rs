@@ -2,6 +2,8 @@
 //! boundary recovery (empty encroachment), domain marking, then cleaning of size-bad,
 //! radius-edge-bad and sliver tets from random points of picking regions.
 
+#[cfg(test)]
+mod check;
 mod domain;
 pub mod existing;
 pub(crate) mod levels;

@@ -27,7 +27,7 @@ pub enum Settled {
 
 /// Why a boundary element is not conforming yet.
 #[derive(Debug, Clone, Copy, PartialEq)]
-enum Status {
+pub(super) enum Status {
     Ok,
     Missing,
     Encroached,
@@ -116,7 +116,7 @@ impl Domain {
     /// A subsegment is fine when it is an edge of the triangulation and no vertex of a tet
     /// around it lies strictly inside its diametric ball (for a Delaunay edge, a vertex in the
     /// ball implies one among the edge's link).
-    fn subsegment_status(&self, a: u32, b: u32) -> Status {
+    pub(super) fn subsegment_status(&self, a: u32, b: u32) -> Status {
         let mut ring = Vec::with_capacity(16);
         if !self.dt.edge_ring(a, b, &mut ring) {
             return Status::Missing;
@@ -136,7 +136,7 @@ impl Domain {
 
     /// A subfacet is fine when it is a face of the triangulation and neither apex of its two
     /// tets lies strictly inside its equatorial ball.
-    fn subfacet_status(&self, t: [u32; 3]) -> Status {
+    pub(super) fn subfacet_status(&self, t: [u32; 3]) -> Status {
         let Some(sides) = self.dt.find_face(t[0], t[1], t[2]) else {
             return Status::Missing;
         };
@@ -225,6 +225,10 @@ impl Domain {
                     self.split_subsegment(x, y, p, None)?;
                 }
             }
+            // The subfacet yielded to the subsegments but is still encroached unless those
+            // splits changed it: it is looked at again (nothing else queues it when the
+            // subsegments are not its edges).
+            self.dirty_tris.push(tri);
             return Ok(true);
         }
         // The centre may still be refused: beyond a subsegment that it does not encroach
@@ -240,6 +244,7 @@ impl Domain {
             }
             let p = self.segment_split_point(x, y);
             self.split_subsegment(x, y, p, None)?;
+            self.dirty_tris.push(tri); // looked at again, as above
             return Ok(true);
         } else {
             (a + b + c) / 3.0
