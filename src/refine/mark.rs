@@ -6,7 +6,7 @@
 use super::domain::{tri_key, Domain, VertexKind};
 use super::MeshError;
 use crate::delaunay::{tables::FACE, INFINITE};
-use crate::plc::PlcInput;
+use crate::plc::{CellKind, Plc};
 use crate::union_find::UnionFind;
 use rustc_hash::FxHashMap;
 
@@ -27,38 +27,40 @@ pub enum Unseeded {
 }
 
 impl Domain {
-    pub fn mark_domain(
-        &mut self,
-        input: &PlcInput,
-        unseeded: Unseeded,
-    ) -> Result<Regions, MeshError> {
+    /// Tags every tet with its component: 0 outside (touching the hull, or a hole), else one
+    /// tag per inside component with its region's attribute and size limit. Which cells are
+    /// holes and which region seed selects a cell are the checked PLC's decisions
+    /// (`plc::Plc::cells`); each selecting seed is located in the triangulation to find its
+    /// component.
+    pub fn mark_domain(&mut self, plc: &Plc, unseeded: Unseeded) -> Result<Regions, MeshError> {
         let (comp, mut outside) = self.components();
         let n_comp = outside.len() as u32;
         let cap = self.dt.tet_capacity();
         let mut attribute: Vec<Option<i32>> = vec![None; n_comp as usize];
         let mut max_size: Vec<Option<f64>> = vec![None; n_comp as usize];
-        for (k, h) in input.holes.iter().enumerate() {
-            let t = self.dt.locate_point(*h, None);
-            let c = comp[t as usize] as usize;
+        for cell in &plc.cells {
+            let (seed, point) = match cell.kind {
+                CellKind::Hole { seed } => (format!("hole {seed}"), plc.holes[seed]),
+                CellKind::Domain { region: Some(r) } => {
+                    (format!("region {r} seed"), plc.regions[r].point)
+                }
+                CellKind::Exterior | CellKind::Domain { region: None } => continue,
+            };
+            let c = comp[self.dt.locate_point(point, None) as usize] as usize;
             if outside[c] {
-                return Err(MeshError::InvalidInput(format!(
-                    "hole {k} at ({}, {}, {}) is outside the domain",
-                    h.x, h.y, h.z
+                // The validator placed the seed in a bounded cell: the triangulation disagrees.
+                return Err(MeshError::Internal(format!(
+                    "{seed} at ({}, {}, {}) lies in the triangulation's outside",
+                    point.x, point.y, point.z
                 )));
             }
-            outside[c] = true;
-        }
-        for (k, r) in input.regions.iter().enumerate() {
-            let t = self.dt.locate_point(r.point, None);
-            let c = comp[t as usize] as usize;
-            if outside[c] {
-                return Err(MeshError::InvalidInput(format!(
-                    "region {k} seed ({}, {}, {}) is outside the domain or in a hole",
-                    r.point.x, r.point.y, r.point.z
-                )));
+            match cell.kind {
+                CellKind::Domain { region: Some(r) } => {
+                    attribute[c] = Some(plc.regions[r].attribute);
+                    max_size[c] = plc.regions[r].max_size.filter(|&s| s > 0.0);
+                }
+                _ => outside[c] = true,
             }
-            attribute[c] = Some(r.attribute);
-            max_size[c] = r.max_size.filter(|&s| s > 0.0);
         }
         if unseeded == Unseeded::Hole {
             for (out, a) in outside.iter_mut().zip(&attribute) {

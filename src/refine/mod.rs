@@ -454,7 +454,7 @@ fn mesh_domain(
     if dom.recover_boundary(&mut budget)? == Settled::BudgetSpent {
         return Err(recovery_budget_spent(params));
     }
-    let mut regions = dom.mark_domain(input, unseeded)?;
+    let mut regions = dom.mark_domain(&plc, unseeded)?;
     let seconds_recovery = start.elapsed().as_secs_f64();
     let auto;
     let spacing: &dyn Spacing = match spacing {
@@ -467,7 +467,7 @@ fn mesh_domain(
     let mut passes = Passes::default();
     if params.refine {
         let mut ctx = PassContext {
-            input,
+            plc: &plc,
             params,
             spacing,
             unseeded,
@@ -539,7 +539,7 @@ fn recovery_budget_spent(params: &Params) -> MeshError {
 
 /// The inputs of [`refine_passes`].
 struct PassContext<'a> {
-    input: &'a PlcInput,
+    plc: &'a crate::plc::Plc,
     params: &'a Params,
     spacing: &'a dyn Spacing,
     unseeded: Unseeded,
@@ -579,7 +579,7 @@ fn refine_passes(
         if dom.recover_boundary(ctx.budget)? == Settled::BudgetSpent {
             return Err(recovery_budget_spent(ctx.params));
         }
-        *regions = dom.mark_domain(ctx.input, ctx.unseeded)?;
+        *regions = dom.mark_domain(ctx.plc, ctx.unseeded)?;
         let relabelled = labels
             .iter()
             .zip(tet_labels(dom, regions))

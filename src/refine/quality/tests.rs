@@ -42,7 +42,7 @@ fn settled_cube() -> (Domain, Regions) {
     );
     dom.check().unwrap();
     let regions = dom
-        .mark_domain(&input, super::super::mark::Unseeded::Domain)
+        .mark_domain(&plc, super::super::mark::Unseeded::Domain)
         .unwrap();
     (dom, regions)
 }
@@ -305,7 +305,7 @@ fn boundary_complex_invariants_hold_through_refinement() {
         dom.check()
             .unwrap_or_else(|e| panic!("{name} after recovery: {e}"));
         let regions = dom
-            .mark_domain(&input, super::super::mark::Unseeded::Domain)
+            .mark_domain(&plc, super::super::mark::Unseeded::Domain)
             .unwrap();
         let spacing = super::super::AutoSpacing::from_boundary(&dom);
         let mut refiner = Refiner::new(&mut dom, &params, &spacing, &regions);
