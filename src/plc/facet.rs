@@ -10,7 +10,7 @@
 
 use super::error::{PlcError, PolygonKind, PolygonRef};
 use super::exact::{orient2d, segments_meet_2d, shared_end_overlap_2d, P2};
-use super::plane::{fit_plane, Plane};
+use super::plane::{fit_plane, Fit, Plane};
 use super::Facet;
 use crate::geom::check_coordinate;
 use glam::DVec3;
@@ -125,10 +125,25 @@ pub fn build_facet(k: usize, facet: &Facet, vertices: &[DVec3]) -> Result<PlcFac
         return Err(PlcError::EmptyFacet { facet: k });
     }
 
+    if let Some(triangle) = single_triangle(k, facet, &polygons, &lone, vertices)? {
+        return Ok(triangle);
+    }
+    triangulate(k, facet, &polygons, &lone, vertices)
+}
+
+/// The general path of [`build_facet`], after the per-polygon checks: the plane, the
+/// simplicity checks and spade's constrained Delaunay triangulation.
+fn triangulate(
+    k: usize,
+    facet: &Facet,
+    polygons: &[(PolygonRef, &[u32])],
+    lone: &[(PolygonRef, &[u32])],
+    vertices: &[DVec3],
+) -> Result<PlcFacet, PlcError> {
     // Facet-local vertex numbering, in order of first appearance.
     let mut global: Vec<u32> = Vec::new();
     let mut local: FxHashMap<u32, usize> = FxHashMap::default();
-    for &(_, p) in polygons.iter().chain(&lone) {
+    for &(_, p) in polygons.iter().chain(lone) {
         for &v in p {
             local.entry(v).or_insert_with(|| {
                 global.push(v);
@@ -137,40 +152,19 @@ pub fn build_facet(k: usize, facet: &Facet, vertices: &[DVec3]) -> Result<PlcFac
         }
     }
     let points: Vec<DVec3> = global.iter().map(|&v| vertices[v as usize]).collect();
-    // `validate` checks all vertices first; repeated here so this function is safe alone.
-    for (&v, &p) in global.iter().zip(&points) {
-        check_coordinate(p).map_err(|reason| PlcError::BadCoordinate {
-            vertex: v as usize,
-            coords: p,
-            reason,
-        })?;
-    }
     let first: Vec<DVec3> = polygons[0]
         .1
         .iter()
         .map(|&v| vertices[v as usize])
         .collect();
-    let fit = fit_plane(&points, &first);
-    if fit.degenerate {
-        return Err(PlcError::DegenerateFacet { facet: k });
-    }
-    if fit.worst.1 > fit.tolerance {
-        let v = global[fit.worst.0];
-        return Err(PlcError::NonPlanarFacet {
-            facet: k,
-            vertex: v,
-            coords: vertices[v as usize],
-            distance: fit.worst.1,
-            tolerance: fit.tolerance,
-        });
-    }
+    let fit = checked_plane(k, &global, &points, &first)?;
     let plane = fit.plane;
     let p2: Vec<P2> = points.iter().map(|&p| plane.project(p)).collect();
     check_coincident(k, &p2, &global)?;
 
     let mut edges: Vec<LocalEdge> = Vec::new();
     let mut seen: FxHashSet<(usize, usize)> = FxHashSet::default();
-    for &(r, p) in &polygons {
+    for &(r, p) in polygons {
         for i in 0..p.len() {
             let (a, b) = (local[&p[i]], local[&p[(i + 1) % p.len()]]);
             // The same edge in two polygons of one facet is one constraint.
@@ -180,7 +174,7 @@ pub fn build_facet(k: usize, facet: &Facet, vertices: &[DVec3]) -> Result<PlcFac
         }
     }
     check_simple(&p2, &edges, &global)?;
-    check_lone_points_off_edges(&lone, &p2, &edges, &local)?;
+    check_lone_points_off_edges(lone, &p2, &edges, &local)?;
 
     let cdt = Cdt::bulk_load_cdt(
         p2.iter().map(|p| Point2::new(p[0], p[1])).collect(),
@@ -201,7 +195,7 @@ pub fn build_facet(k: usize, facet: &Facet, vertices: &[DVec3]) -> Result<PlcFac
             });
         }
     }
-    let outside = classify_faces(k, facet, &polygons, &cdt, &p2, &local, &plane)?;
+    let outside = classify_faces(k, facet, polygons, &cdt, &p2, &local, &plane)?;
     let (loops, interior_edges) = boundary_loops(&cdt, &edges, &outside, &global, &p2)?;
 
     let mut triangles = Vec::new();
@@ -215,7 +209,7 @@ pub fn build_facet(k: usize, facet: &Facet, vertices: &[DVec3]) -> Result<PlcFac
         area += (b - a).cross(c - a).length() / 2.0;
         triangles.push(t);
     }
-    check_lone_points_covered(&lone, &triangles)?;
+    check_lone_points_covered(lone, &triangles)?;
     let facet = PlcFacet {
         marker: facet.marker,
         plane,
@@ -230,6 +224,119 @@ pub fn build_facet(k: usize, facet: &Facet, vertices: &[DVec3]) -> Result<PlcFac
         "facet {k}: triangles do not tile the polygon"
     );
     Ok(facet)
+}
+
+/// Checks a facet's vertex coordinates and fits its plane: `global` are the facet's vertex
+/// ids, `points` their positions, `first` the positions of its first polygon in order (they
+/// orient the normal).
+fn checked_plane(
+    k: usize,
+    global: &[u32],
+    points: &[DVec3],
+    first: &[DVec3],
+) -> Result<Fit, PlcError> {
+    // `validate` checks all vertices first; repeated here so `build_facet` is safe alone.
+    for (&v, &p) in global.iter().zip(points) {
+        check_coordinate(p).map_err(|reason| PlcError::BadCoordinate {
+            vertex: v as usize,
+            coords: p,
+            reason,
+        })?;
+    }
+    let fit = fit_plane(points, first);
+    if fit.degenerate {
+        return Err(PlcError::DegenerateFacet { facet: k });
+    }
+    if fit.worst.1 > fit.tolerance {
+        let v = global[fit.worst.0];
+        return Err(PlcError::NonPlanarFacet {
+            facet: k,
+            vertex: v,
+            coords: points[fit.worst.0],
+            distance: fit.worst.1,
+            tolerance: fit.tolerance,
+        });
+    }
+    Ok(fit)
+}
+
+/// The fast path of [`build_facet`] for a facet that is one triangle and nothing else (almost
+/// every facet of a triangulated surface): the triangle is its own triangulation, so spade is
+/// not called. `None` when the facet is anything else, or when its projection is not a
+/// counter-clockwise triangle (then the general path decides, errors included).
+///
+/// The result is exactly what [`triangulate`] gives, vertex order included (the area and
+/// everything downstream read the triangle in that order; test
+/// `single_triangles_match_the_general_path`): the loop is the polygon, and spade's one inner
+/// face starts at the vertex [`spade_first_corner`] names.
+fn single_triangle(
+    k: usize,
+    facet: &Facet,
+    polygons: &[(PolygonRef, &[u32])],
+    lone: &[(PolygonRef, &[u32])],
+    vertices: &[DVec3],
+) -> Result<Option<PlcFacet>, PlcError> {
+    let tri: [u32; 3] = match polygons {
+        [(_, p)] if lone.is_empty() && facet.hole_points.is_empty() => match (*p).try_into() {
+            Ok(t) => t,
+            Err(_) => return Ok(None),
+        },
+        _ => return Ok(None),
+    };
+    let points = tri.map(|v| vertices[v as usize]);
+    let fit = checked_plane(k, &tri, &points, &points)?;
+    let plane = fit.plane;
+    let p2 = points.map(|p| plane.project(p));
+    if orient2d(p2[0], p2[1], p2[2]) != Ordering::Greater {
+        return Ok(None);
+    }
+    let first = spade_first_corner(&p2);
+    let t = [0, 1, 2].map(|i| tri[(first + i) % 3]);
+    let [a, b, c] = t.map(|v| vertices[v as usize]);
+    let area = (b - a).cross(c - a).length() / 2.0;
+    Ok(Some(PlcFacet {
+        marker: facet.marker,
+        plane,
+        loops: vec![FacetLoop {
+            vertices: tri.to_vec(),
+            is_hole: twice_signed_area(&[0, 1, 2], &p2) < 0.0,
+        }],
+        interior_edges: Vec::new(),
+        triangles: vec![t],
+        area,
+        triangle_cells: Vec::new(),
+    }))
+}
+
+/// The corner spade 2.15's bulk loading starts the one inner face of a counter-clockwise
+/// triangle at: it inserts the points nearest first to their mean (squared distance, ties by
+/// larger x, then larger y) and the face starts at the last one inserted. Computed with
+/// spade's own arithmetic (sum from zero, times 1/3) so that ties come out the same.
+fn spade_first_corner(p: &[P2; 3]) -> usize {
+    let sum = p.iter().fold([0.0, 0.0], |s, q| [s[0] + q[0], s[1] + q[1]]);
+    let centre = [sum[0] * (1.0 / 3.0), sum[1] * (1.0 / 3.0)];
+    let distance = |q: P2| {
+        let (dx, dy) = (centre[0] - q[0], centre[1] - q[1]);
+        dx * dx + dy * dy
+    };
+    // The first in spade's order (farthest, then smallest x, then smallest y) is inserted last.
+    let inserted_later = |i: usize, j: usize| {
+        let (di, dj) = (distance(p[i]), distance(p[j]));
+        di > dj || (di == dj && (p[i][0], p[i][1]) < (p[j][0], p[j][1]))
+    };
+    (1..3).fold(0, |best, i| if inserted_later(i, best) { i } else { best })
+}
+
+/// Twice the signed area of the loop `lp` (local ids into `p2`), by the shoelace formula
+/// relative to its first vertex, to limit cancellation.
+fn twice_signed_area(lp: &[usize], p2: &[P2]) -> f64 {
+    let o = p2[lp[0]];
+    (0..lp.len())
+        .map(|i| {
+            let (a, b) = (p2[lp[i]], p2[lp[(i + 1) % lp.len()]]);
+            (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+        })
+        .sum()
 }
 
 /// Index range, length and repeated vertices of one polygon.
@@ -564,20 +671,72 @@ fn boundary_loops(
                     .expect("facet boundary is a cycle");
                 used += 1;
             }
-            // Shoelace relative to the first vertex, to limit cancellation.
-            let o = p2[lp[0]];
-            let twice: f64 = (0..lp.len())
-                .map(|i| {
-                    let (a, b) = (p2[lp[i]], p2[lp[(i + 1) % lp.len()]]);
-                    (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-                })
-                .sum();
             loops.push(FacetLoop {
                 vertices: lp.iter().map(|&i| global[i]).collect(),
-                is_hole: twice < 0.0,
+                is_hole: twice_signed_area(&lp, p2) < 0.0,
             });
         }
     }
     debug_assert_eq!(used, count);
     Ok((loops, interior))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+
+    /// The general path on the same facet, for comparison.
+    fn general(facet: &Facet, vertices: &[DVec3]) -> Result<PlcFacet, PlcError> {
+        let r = PolygonRef {
+            facet: 0,
+            kind: PolygonKind::Outer,
+            index: 0,
+        };
+        triangulate(0, facet, &[(r, &facet.polygons[0])], &[], vertices)
+    }
+
+    /// The fast path for one-triangle facets gives what spade's triangulation gives, bit for
+    /// bit, corner order included: random triangles in every orientation, on a coarse grid
+    /// (many ties in spade's distance order) and at random coordinates.
+    #[test]
+    fn single_triangles_match_the_general_path() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        let mut fast = 0;
+        for round in 0..20_000 {
+            let coordinate = |rng: &mut rand_chacha::ChaCha8Rng| match round % 3 {
+                0 => rng.gen_range(-2..=2) as f64,
+                1 => rng.gen_range(-20..=20) as f64 * 0.1,
+                _ => rng.gen_range(-1.0..1.0) * 1e3,
+            };
+            let vertices: Vec<DVec3> = (0..3)
+                .map(|_| {
+                    let x = coordinate(&mut rng);
+                    let y = coordinate(&mut rng);
+                    let z = coordinate(&mut rng);
+                    DVec3::new(x, y, z)
+                })
+                .collect();
+            let facet = Facet {
+                polygons: vec![vec![0, 1, 2]],
+                marker: 7,
+                ..Facet::default()
+            };
+            let expected = general(&facet, &vertices);
+            let got = build_facet(0, &facet, &vertices);
+            assert_eq!(got, expected, "{vertices:?}");
+            let r = PolygonRef {
+                facet: 0,
+                kind: PolygonKind::Outer,
+                index: 0,
+            };
+            let one = [(r, facet.polygons[0].as_slice())];
+            fast += usize::from(matches!(
+                single_triangle(0, &facet, &one, &[], &vertices),
+                Ok(Some(_))
+            ));
+        }
+        // Collinear draws fail both ways; every other draw takes the fast path.
+        assert!(fast > 15_000, "{fast}");
+    }
 }
