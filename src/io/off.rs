@@ -69,23 +69,24 @@ fn parse_body(
     let mut plc = PlcInput::default();
     plc.vertices.reserve(super::text::cap(nv));
     for i in 0..nv {
-        let mut r = lines.next(&format!("vertex {} of {nv}", i + 1))?;
+        let mut r = lines.next(&format_args!("vertex {} of {nv}", i + 1))?;
         plc.vertices.push(r.point()?);
     }
     plc.facets.reserve(super::text::cap(nf));
     for i in 0..nf {
-        let fname = format!("face {} of {nf}", i + 1);
-        let mut r = lines.next(&fname)?;
-        let k = r.usize(&format!("number of corners of {fname}"))?;
+        // Names for error messages, formatted only when one is made.
+        let face = i + 1;
+        let mut r = lines.next(&format_args!("face {face} of {nf}"))?;
+        let k = r.usize(&format_args!("number of corners of face {face} of {nf}"))?;
         if k < 3 {
             return Err(err_at(
                 r.line,
-                format!("{fname} has {k} corners (at least 3 needed)"),
+                format!("face {face} of {nf} has {k} corners (at least 3 needed)"),
             ));
         }
         let mut poly = Vec::with_capacity(super::text::cap(k));
         for _ in 0..k {
-            poly.push(r.index(0, nv, &format!("{fname}: vertex index"))?);
+            poly.push(r.index(0, nv, &format_args!("face {face} of {nf}: vertex index"))?);
         }
         plc.facets.push(Facet {
             polygons: vec![poly],

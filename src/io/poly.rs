@@ -124,7 +124,7 @@ fn parse_node_section(lines: &mut Lines, mut header: Record) -> Result<Option<No
     let mut vertices = Vec::with_capacity(super::text::cap(n));
     let mut base = 0;
     for i in 0..n {
-        let mut r = lines.next(&format!("point {} of {n}", i + 1))?;
+        let mut r = lines.next(&format_args!("point {} of {n}", i + 1))?;
         let id = r.i64("point id")?;
         if i == 0 {
             if id != 0 && id != 1 {
@@ -173,7 +173,7 @@ fn polygon_indices<'a>(
             line,
             nodes.base,
             n,
-            &format!("{what}: vertex index"),
+            &format_args!("{what}: vertex index"),
         )?);
     }
     Ok(poly)

@@ -77,7 +77,11 @@ pub(crate) fn cap(n: usize) -> usize {
 }
 
 /// Converts a vertex count or index to `u32`, the id type of the mesh model.
-pub(crate) fn to_u32(n: usize, line: usize, what: &str) -> Result<u32, IoError> {
+pub(crate) fn to_u32(
+    n: usize,
+    line: usize,
+    what: &(impl fmt::Display + ?Sized),
+) -> Result<u32, IoError> {
     u32::try_from(n).map_err(|_| err_at(line, format!("{what} {n} is too large (limit 2^32-1)")))
 }
 
@@ -128,7 +132,10 @@ impl<'a> Lines<'a> {
     }
 
     /// The next non-blank record; end of file is an error naming what was expected.
-    pub(crate) fn next(&mut self, what: &str) -> Result<Record<'a>, IoError> {
+    pub(crate) fn next(
+        &mut self,
+        what: &(impl fmt::Display + ?Sized),
+    ) -> Result<Record<'a>, IoError> {
         match self.next_opt() {
             Some(r) => Ok(r),
             None => Err(self.eof(what)),
@@ -148,7 +155,7 @@ impl<'a> Lines<'a> {
     }
 
     /// An "unexpected end of file" error, reported at the line after the last record read.
-    pub(crate) fn eof(&self, what: &str) -> IoError {
+    pub(crate) fn eof(&self, what: &(impl fmt::Display + ?Sized)) -> IoError {
         err_at(
             self.last + 1,
             format!("unexpected end of file: expected {what}"),
@@ -179,7 +186,7 @@ impl<'a> Record<'a> {
     }
 
     /// The next field as text; end of line is an error naming what was expected.
-    pub(crate) fn word(&mut self, what: &str) -> Result<&'a str, IoError> {
+    pub(crate) fn word(&mut self, what: &(impl fmt::Display + ?Sized)) -> Result<&'a str, IoError> {
         self.fields
             .next()
             .ok_or_else(|| err_at(self.line, format!("expected {what}, found end of line")))
@@ -200,7 +207,7 @@ impl<'a> Record<'a> {
         parse_i32(w, self.line, what)
     }
 
-    pub(crate) fn usize(&mut self, what: &str) -> Result<usize, IoError> {
+    pub(crate) fn usize(&mut self, what: &(impl fmt::Display + ?Sized)) -> Result<usize, IoError> {
         let w = self.word(what)?;
         parse_usize(w, self.line, what)
     }
@@ -236,7 +243,12 @@ impl<'a> Record<'a> {
     }
 
     /// A 0-based vertex id from a `base`-based index, checked against `n` vertices.
-    pub(crate) fn index(&mut self, base: usize, n: usize, what: &str) -> Result<u32, IoError> {
+    pub(crate) fn index(
+        &mut self,
+        base: usize,
+        n: usize,
+        what: &(impl fmt::Display + ?Sized),
+    ) -> Result<u32, IoError> {
         let w = self.word(what)?;
         parse_index(w, self.line, base, n, what)
     }
@@ -333,7 +345,11 @@ pub(crate) fn parse_f64(w: &str, line: usize, what: &str) -> Result<f64, IoError
     }
 }
 
-pub(crate) fn parse_i64(w: &str, line: usize, what: &str) -> Result<i64, IoError> {
+pub(crate) fn parse_i64(
+    w: &str,
+    line: usize,
+    what: &(impl fmt::Display + ?Sized),
+) -> Result<i64, IoError> {
     w.parse::<i64>()
         .map_err(|_| err_at(line, format!("bad integer '{w}' for {what}")))
 }
@@ -343,7 +359,11 @@ pub(crate) fn parse_i32(w: &str, line: usize, what: &str) -> Result<i32, IoError
         .map_err(|_| err_at(line, format!("bad integer '{w}' for {what}")))
 }
 
-pub(crate) fn parse_usize(w: &str, line: usize, what: &str) -> Result<usize, IoError> {
+pub(crate) fn parse_usize(
+    w: &str,
+    line: usize,
+    what: &(impl fmt::Display + ?Sized),
+) -> Result<usize, IoError> {
     w.parse::<usize>()
         .map_err(|_| err_at(line, format!("bad non-negative integer '{w}' for {what}")))
 }
@@ -370,7 +390,7 @@ pub(crate) fn check_index(
     line: usize,
     base: usize,
     n: usize,
-    what: &str,
+    what: &(impl fmt::Display + ?Sized),
 ) -> Result<u32, IoError> {
     let lo = base as i64;
     let hi = n as i64 + lo - 1;
@@ -390,7 +410,7 @@ pub(crate) fn parse_index(
     line: usize,
     base: usize,
     n: usize,
-    what: &str,
+    what: &(impl fmt::Display + ?Sized),
 ) -> Result<u32, IoError> {
     let v = parse_i64(w, line, what)?;
     check_index(v, line, base, n, what)
