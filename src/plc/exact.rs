@@ -158,10 +158,17 @@ pub enum Contact {
 
 /// Classifies the intersection of two non-degenerate triangles given by ids and points.
 pub fn triangle_contact(ti: [u32; 3], t: [DVec3; 3], si: [u32; 3], s: [DVec3; 3]) -> Contact {
-    let shared: Vec<(usize, usize)> = (0..3)
-        .flat_map(|i| (0..3).map(move |j| (i, j)))
-        .filter(|&(i, j)| ti[i] == si[j])
-        .collect();
+    // The shared corners as (index in t, index in s), in a fixed array: this runs for every
+    // pair of neighbouring triangles of the input.
+    let mut pairs = [(0, 0); 3];
+    let mut n_shared = 0;
+    for (i, j) in (0..3).flat_map(|i| (0..3).map(move |j| (i, j))) {
+        if ti[i] == si[j] && n_shared < 3 {
+            pairs[n_shared] = (i, j);
+            n_shared += 1;
+        }
+    }
+    let shared = &pairs[..n_shared];
     // Rotate so the shared vertices come first (cyclic rotations keep orientation).
     let rot = |first: usize| [first, (first + 1) % 3, (first + 2) % 3];
     // Most pairs the broad phase passes are separated by one of the two planes (apart from
