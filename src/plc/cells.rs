@@ -218,6 +218,11 @@ impl Shell {
 /// Sorts the third vertices of the triangles around the axis u→v, counter-clockwise, starting
 /// from `w[0]`. Exact: half-plane classification and `orient3d` comparisons.
 fn radial_order(u: DVec3, v: DVec3, w: &[DVec3]) -> Vec<usize> {
+    // Starting from w[0], one or two triangles have only one order (the edges of a manifold
+    // surface: all but a few).
+    if w.len() <= 2 {
+        return (0..w.len()).collect();
+    }
     // A point off the plane (u, v, w0) tells the two half-planes of that plane apart.
     let q = off_plane_point(u, v, w[0]);
     let ref_side = orient3(u, v, q, w[0]);
