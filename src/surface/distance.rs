@@ -7,6 +7,7 @@
 use super::oracle::SurfaceOracle;
 use super::InputSurface;
 use glam::DVec3;
+use rustc_hash::FxHashMap;
 
 /// The two one-sided distances, each with the sample point that attains it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -38,11 +39,18 @@ pub fn samples(s: &InputSurface, spacing: f64) -> Vec<DVec3> {
 /// point of it is farther than `spacing` / sqrt(3) from a sample. A long thin triangle, where
 /// that grid would be mostly redundant points along its length, is sampled in rows instead
 /// (see [`Rows`]), with the same guarantee and fewer samples.
+///
+/// Each sample is taken once: a vertex by the first triangle using it, an edge's grid points
+/// by the first triangle cutting it into as many pieces (its neighbour mostly does: the two
+/// triangles' grids meet there), from its lower vertex id to the higher so that both
+/// triangles would compute the same points.
 pub fn samples_per_edge_at_least(s: &InputSurface, spacing: f64, min_pieces: usize) -> Vec<DVec3> {
     assert!(spacing > 0.0, "sampling spacing must be positive");
     let mut out = Vec::new();
-    // A vertex is shared by about six triangles: it is sampled once, by the first of them.
     let mut vertex_done = vec![false; s.vertices.len()];
+    // Edge (sorted ids) -> the number of pieces its grid points were taken with.
+    let mut edge_done: FxHashMap<[u32; 2], usize> = FxHashMap::default();
+    edge_done.reserve(s.triangles.len() * 3 / 2);
     for t in 0..s.triangles.len() {
         for v in s.triangles[t] {
             if !std::mem::replace(&mut vertex_done[v as usize], true) {
@@ -58,13 +66,19 @@ pub fn samples_per_edge_at_least(s: &InputSurface, spacing: f64, min_pieces: usi
             rows.sample_inside(&mut out);
             continue;
         }
-        for i in 0..=k {
-            for j in 0..=(k - i) {
-                let corner = (i == 0 || i == k) && j == 0 || (i == 0 && j == k);
-                if !corner {
-                    let (u, v) = (i as f64 / k as f64, j as f64 / k as f64);
-                    out.push(a + (b - a) * u + (c - a) * v);
-                }
+        let ids = s.triangles[t];
+        for e in 0..3 {
+            let (u, v) = (ids[e].min(ids[(e + 1) % 3]), ids[e].max(ids[(e + 1) % 3]));
+            if edge_done.insert([u, v], k) != Some(k) {
+                let (p, q) = (s.vertices[u as usize], s.vertices[v as usize]);
+                out.extend((1..k).map(|i| p + (q - p) * (i as f64 / k as f64)));
+            }
+        }
+        // The points strictly inside.
+        for i in 1..k {
+            for j in 1..(k - i) {
+                let (u, v) = (i as f64 / k as f64, j as f64 / k as f64);
+                out.push(a + (b - a) * u + (c - a) * v);
             }
         }
     }

@@ -402,3 +402,35 @@ fn samples_cover_thin_and_fat_triangles() {
         }
     }
 }
+
+#[test]
+fn samples_of_a_closed_surface_cover_it_each_once() {
+    // Neighbouring triangles share their edges' grid points: each is taken once, and every
+    // point of every triangle still lies within spacing / sqrt(3) of a sample.
+    let s = prism(16, 1.0);
+    let spacing = 0.07;
+    let pts = samples(&s, spacing);
+    for (i, p) in pts.iter().enumerate() {
+        let twice = pts[i + 1..].iter().any(|q| (*q - *p).length() < 1e-12);
+        assert!(!twice, "sample {i} taken twice");
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    for t in 0..s.triangles.len() {
+        let [a, b, c] = s.corners(t);
+        for _ in 0..50 {
+            let (mut u, mut v) = (rng.gen::<f64>(), rng.gen::<f64>());
+            if u + v > 1.0 {
+                (u, v) = (1.0 - u, 1.0 - v);
+            }
+            let x = a + (b - a) * u + (c - a) * v;
+            let near = pts
+                .iter()
+                .map(|p| (*p - x).length())
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                near <= spacing / 3f64.sqrt() * (1.0 + 1e-9),
+                "triangle {t}: {near}"
+            );
+        }
+    }
+}
