@@ -283,8 +283,15 @@ impl SurfaceOracle {
                 continue;
             }
             if node.count > 0 {
-                for &t in self.leaf_triangles(node) {
-                    if within(t) {
+                let range = node.first as usize..(node.first + node.count) as usize;
+                for (&t, b) in self.leaf_tri[range.clone()]
+                    .iter()
+                    .zip(&self.leaf_box[range])
+                {
+                    // A piece whose (padded) box is farther than r does not hold the point of
+                    // its triangle nearest to p, if that is within r: the piece that does is
+                    // visited too. The box test is much cheaper than the closest point.
+                    if aabb_distance(b, p) <= r && within(t) {
                         *hint = Some(t);
                         return None;
                     }
@@ -818,10 +825,11 @@ fn crossing_parameter(p: DVec3, q: DVec3, a: DVec3, b: DVec3, c: DVec3, dp: f64,
 }
 
 fn box_distance(node: &Node, p: DVec3) -> f64 {
-    let d = (node.bounds.lo - p)
-        .max(p - node.bounds.hi)
-        .max(DVec3::ZERO);
-    d.length()
+    aabb_distance(&node.bounds, p)
+}
+
+fn aabb_distance(b: &Aabb, p: DVec3) -> f64 {
+    (b.lo - p).max(p - b.hi).max(DVec3::ZERO).length()
 }
 
 /// Segment [p, q] set up for slab tests against many boxes.
