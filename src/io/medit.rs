@@ -15,7 +15,7 @@
 
 use super::text::{
     check_index, check_mesh, check_mesh_io, create, err_at, read_text, to_u32, with_path,
-    write_err, Tokens, F,
+    write_err, write_int_line, Tokens, F,
 };
 use super::IoError;
 use crate::mesh::TetMesh;
@@ -35,6 +35,7 @@ pub fn write_medit(path: &Path, mesh: &TetMesh) -> Result<(), IoError> {
 /// An inconsistent mesh is an `InvalidInput` error.
 pub fn format_medit<W: Write>(w: &mut W, mesh: &TetMesh) -> std::io::Result<()> {
     check_mesh_io(mesh, &[])?;
+    let mut line = Vec::new();
     writeln!(w, "MeshVersionFormatted 2\n\nDimension 3\n")?;
     writeln!(w, "Vertices\n{}", mesh.vertices.len())?;
     for p in &mesh.vertices {
@@ -42,14 +43,16 @@ pub fn format_medit<W: Write>(w: &mut W, mesh: &TetMesh) -> std::io::Result<()> 
     }
     if !mesh.tets.is_empty() {
         writeln!(w, "\nTetrahedra\n{}", mesh.tets.len())?;
-        for (t, r) in mesh.tets.iter().zip(&mesh.tet_regions) {
-            writeln!(w, "{} {} {} {} {r}", t[0] + 1, t[1] + 1, t[2] + 1, t[3] + 1)?;
+        for (t, &r) in mesh.tets.iter().zip(&mesh.tet_regions) {
+            let [a, b, c, d] = t.map(|v| i64::from(v) + 1);
+            write_int_line(w, &mut line, &[a, b, c, d, i64::from(r)])?;
         }
     }
     if !mesh.boundary.is_empty() {
         writeln!(w, "\nTriangles\n{}", mesh.boundary.len())?;
-        for (t, m) in mesh.boundary.iter().zip(&mesh.boundary_markers) {
-            writeln!(w, "{} {} {} {m}", t[0] + 1, t[1] + 1, t[2] + 1)?;
+        for (t, &m) in mesh.boundary.iter().zip(&mesh.boundary_markers) {
+            let [a, b, c] = t.map(|v| i64::from(v) + 1);
+            write_int_line(w, &mut line, &[a, b, c, i64::from(m)])?;
         }
     }
     writeln!(w, "\nEnd")

@@ -16,7 +16,7 @@
 use super::poly::{parse_node, NodeList};
 use super::text::{
     check_mesh, check_mesh_io, create, err_at, parse_integral_i32, read_text, with_path, write_err,
-    Lines, F,
+    write_int_line, Lines, F,
 };
 use super::IoError;
 use crate::mesh::TetMesh;
@@ -82,21 +82,6 @@ pub fn format_face(w: &mut dyn Write, mesh: &TetMesh) -> std::io::Result<()> {
         write_int_line(w, &mut line, &[i as i64 + 1, a, b, c, i64::from(m)])?;
     }
     writeln!(w, "# written by slivermesh")
-}
-
-/// Writes `values` as one line, separated by spaces. The .ele/.face hot loop: formatting with
-/// itoa into a reused buffer is several times faster than `writeln!` through `dyn Write`.
-fn write_int_line(w: &mut dyn Write, line: &mut Vec<u8>, values: &[i64]) -> std::io::Result<()> {
-    line.clear();
-    let mut buf = itoa::Buffer::new();
-    for (k, &v) in values.iter().enumerate() {
-        if k > 0 {
-            line.push(b' ');
-        }
-        line.extend_from_slice(buf.format(v).as_bytes());
-    }
-    line.push(b'\n');
-    w.write_all(line)
 }
 
 /// Reads `X.node`, `X.ele` and (if present) `X.face`.
