@@ -56,7 +56,7 @@ pub fn surface_report(r: &Remeshed, mesh: &TetMesh) -> SurfaceReport {
         .sum();
     SurfaceReport {
         surface_distance: r.distance,
-        hausdorff_input_to_output: one_sided(&r.surface, &SurfaceOracle::new(&out)),
+        hausdorff_input_to_output: one_sided(&r.surface, &SurfaceOracle::for_distances(&out)),
         hausdorff_output_to_input: one_sided(&out, &r.oracle),
         feature_distance: feature_distance(r, &mesh.vertices),
         relative_volume_difference: if r.input_volume > 0.0 {

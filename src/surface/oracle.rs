@@ -97,6 +97,17 @@ pub struct SurfaceOracle {
 impl SurfaceOracle {
     /// The oracle of `surface` (it keeps copies of what it needs: the surface may go).
     pub fn new(surface: &InputSurface) -> SurfaceOracle {
+        Self::build(surface, true)
+    }
+
+    /// An oracle for distance queries ([`Self::closest`], [`Self::distance_beyond_hinted`]):
+    /// without the occupancy grid, which only answers segment queries early (they still work,
+    /// through the tree) and costs as much to build as the tree on a coarse surface.
+    pub fn for_distances(surface: &InputSurface) -> SurfaceOracle {
+        Self::build(surface, false)
+    }
+
+    fn build(surface: &InputSurface, with_grid: bool) -> SurfaceOracle {
         let n = surface.triangles.len();
         let diagonal = surface.bbox_diagonal();
         let pieces = cut_into_pieces(surface, PIECE_FRACTION * diagonal);
@@ -107,7 +118,11 @@ impl SurfaceOracle {
             leaf_tri: vec![],
             leaf_box: vec![],
             neighbours: edge_neighbours(&surface.triangles),
-            grid: Occupancy::new(&pieces, &corners, GRID_FRACTION * diagonal),
+            grid: if with_grid {
+                Occupancy::new(&pieces, &corners, GRID_FRACTION * diagonal)
+            } else {
+                Occupancy::empty()
+            },
             corners,
             pieces,
             flat: (0..n).map(|t| is_flat(surface.corners(t))).collect(),
@@ -493,6 +508,16 @@ const GRID_SPAN: usize = 6;
 const GRID_FRACTION: f64 = 1.0 / 128.0;
 
 impl Occupancy {
+    /// No cells: every segment goes to the tree.
+    fn empty() -> Occupancy {
+        Occupancy {
+            origin: DVec3::ZERO,
+            cell: 1.0,
+            dims: [0; 3],
+            bits: vec![],
+        }
+    }
+
     fn new(pieces: &[Piece], corners: &[[DVec3; 3]], cell: f64) -> Occupancy {
         let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
         for p in pieces {
@@ -500,12 +525,7 @@ impl Occupancy {
             hi = hi.max(p.hi);
         }
         if pieces.is_empty() || cell.is_nan() || cell <= 0.0 {
-            return Occupancy {
-                origin: DVec3::ZERO,
-                cell: 1.0,
-                dims: [0; 3],
-                bits: vec![],
-            };
+            return Occupancy::empty();
         }
         // One cell of margin on each side, so that rounding at the box never matters.
         let origin = lo - DVec3::splat(cell);
