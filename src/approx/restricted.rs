@@ -828,7 +828,7 @@ impl<'a> SurfaceMesher<'a> {
             .map(|&(t, i)| FACE[i].map(|k| self.dt.tet(t)[k]))
             .collect();
         let extracted = InputSurface::from_triangles(self.dt.points().to_vec(), triangles);
-        let near = SurfaceOracle::new(&extracted);
+        let near = SurfaceOracle::for_distances(&extracted);
         let points = super::measure::hausdorff_samples(self.surface);
         // Consecutive samples come from one input triangle: the last face found is tried first.
         let mut hint = None;
