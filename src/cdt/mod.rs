@@ -388,6 +388,13 @@ impl FacetMesh {
         Ok(fm)
     }
 
+    /// The area [`Self::validate`] expects the facet's triangles to cover, when the caller
+    /// knows it better than the polygons say (outer polygons that nest, as in TetGen's .poly,
+    /// where a hole's outline is a polygon of the facet too).
+    pub fn expect_area(&mut self, area: f64) {
+        self.expected_area = Some(area);
+    }
+
     /// The super-triangle, well around the bounding box (`lo`, `hi`), its vertices put (in
     /// float) on the plane through `plane.v0` so that the lifting treats them like the others.
     fn add_super_triangle(&mut self, plane: &Plane, lo: DVec3, hi: DVec3) {

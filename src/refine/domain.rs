@@ -123,14 +123,17 @@ impl Domain {
         let mut facets = Vec::with_capacity(input.facets.len());
         let mut markers = vec![];
         let mut subfacets = FxHashMap::default();
-        for (fi, f) in input.facets.iter().enumerate() {
-            let fm = FacetMesh::new(
-                &input.vertices,
-                &f.polygons,
-                &f.hole_polygons,
-                &f.hole_points,
-            )
-            .map_err(|e| MeshError::InvalidInput(format!("facet {fi}: {e}")))?;
+        for (fi, (f, checked)) in input.facets.iter().zip(&plc.facets).enumerate() {
+            // The constraints and their order (which decides cocircular ties) are the input's
+            // polygons; which regions of the facet are holes is the validator's decision, its
+            // hole loops (from hole polygons and hole points alike), not a rule of our own.
+            let holes: Vec<Vec<u32>> = (checked.loops.iter())
+                .filter(|l| l.is_hole)
+                .map(|l| l.vertices.clone())
+                .collect();
+            let mut fm = FacetMesh::new(&input.vertices, &f.polygons, &holes, &[])
+                .map_err(|e| MeshError::InvalidInput(format!("facet {fi}: {e}")))?;
+            fm.expect_area(checked.area);
             for t in fm.triangles() {
                 subfacets.insert(tri_key(t), fi as u32);
             }

@@ -270,7 +270,9 @@ fn plc_facet_level_conflicts_follow_the_request() {
 /// The boundary complex's invariants (`Domain::check`) hold after boundary recovery and after
 /// refinement on the small models of both kinds and on part.off (small input angles). Before
 /// a subfacet that yielded to a subsegment split was queued again, tetgen_example.poly was left
-/// with an encroached subfacet after recovery. And the check can fail: a volume vertex left
+/// with an encroached subfacet after recovery. tetgen_example and drilled_block have facet hole
+/// points: the facet triangulations must leave the validator's hole loops uncovered (their area
+/// is checked against the validator's). And the check can fail: a volume vertex left
 /// in a subsegment's diametric ball (and its subfacets' equatorial balls) is found.
 #[test]
 fn boundary_complex_invariants_hold_through_refinement() {
@@ -284,6 +286,7 @@ fn boundary_complex_invariants_hold_through_refinement() {
         "poly/box_with_cavity.poly",
         "poly/two_materials.poly",
         "poly/tetgen_example.poly",
+        "poly/drilled_block.poly",
         "off/cross.off",
         "off/star.off",
         "off/part.off",
