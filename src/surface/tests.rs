@@ -377,21 +377,14 @@ fn samples_cover_thin_and_fat_triangles() {
         let c = DVec3::new(rng.gen_range(-0.5..2.5), height, rng.gen_range(-0.1..0.1));
         let s = InputSurface::from_triangles(vec![a, b, c], vec![[0, 1, 2]]);
         let pts = samples(&s, spacing);
-        for _ in 0..400 {
-            let (mut u, mut v) = (rng.gen::<f64>(), rng.gen::<f64>());
-            if u + v > 1.0 {
-                (u, v) = (1.0 - u, 1.0 - v);
-            }
-            let x = a + (b - a) * u + (c - a) * v;
-            let near = pts
-                .iter()
-                .map(|p| (*p - x).length())
-                .fold(f64::INFINITY, f64::min);
-            assert!(
-                near <= spacing / 3f64.sqrt() * (1.0 + 1e-9),
-                "case {case}: {near}"
-            );
-        }
+        assert_covered(
+            &pts,
+            [a, b, c],
+            spacing,
+            400,
+            &mut rng,
+            &format!("case {case}"),
+        );
         if case % 2 == 0 {
             let longest = (b - a).length().max((c - b).length()).max((c - a).length());
             let k = (longest / spacing).ceil();
@@ -416,21 +409,41 @@ fn samples_of_a_closed_surface_cover_it_each_once() {
     }
     let mut rng = ChaCha8Rng::seed_from_u64(5);
     for t in 0..s.triangles.len() {
-        let [a, b, c] = s.corners(t);
-        for _ in 0..50 {
-            let (mut u, mut v) = (rng.gen::<f64>(), rng.gen::<f64>());
-            if u + v > 1.0 {
-                (u, v) = (1.0 - u, 1.0 - v);
-            }
-            let x = a + (b - a) * u + (c - a) * v;
-            let near = pts
-                .iter()
-                .map(|p| (*p - x).length())
-                .fold(f64::INFINITY, f64::min);
-            assert!(
-                near <= spacing / 3f64.sqrt() * (1.0 + 1e-9),
-                "triangle {t}: {near}"
-            );
+        let corners = s.corners(t);
+        assert_covered(
+            &pts,
+            corners,
+            spacing,
+            50,
+            &mut rng,
+            &format!("triangle {t}"),
+        );
+    }
+}
+
+/// `n` random points of triangle `abc` each have a sample within spacing / sqrt(3) (the
+/// sampling's guarantee).
+fn assert_covered(
+    pts: &[DVec3],
+    [a, b, c]: [DVec3; 3],
+    spacing: f64,
+    n: usize,
+    rng: &mut ChaCha8Rng,
+    what: &str,
+) {
+    for _ in 0..n {
+        let (mut u, mut v) = (rng.gen::<f64>(), rng.gen::<f64>());
+        if u + v > 1.0 {
+            (u, v) = (1.0 - u, 1.0 - v);
         }
+        let x = a + (b - a) * u + (c - a) * v;
+        let near = pts
+            .iter()
+            .map(|p| (*p - x).length())
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            near <= spacing / 3f64.sqrt() * (1.0 + 1e-9),
+            "{what}: {near}"
+        );
     }
 }
