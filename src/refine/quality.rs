@@ -4,7 +4,8 @@
 //! sliver with circumradius <= b R): the centre c itself if it does not (its cavity is known
 //! from the boundary check), else the best of up to `max_tries` random draws; when its
 //! circumcentre encroaches a subsegment or subfacet, that boundary element is split from its
-//! own picking interval or disk instead.
+//! own picking interval or disk instead. This is keep mode's cell level: the boundary below it
+//! is asked through [`FacetLevel`] (`plc_level.rs`), and Li's point choice is `levels.rs`'s.
 //!
 //! Refining one bad tet (`refine_tet` and the helpers it returns through) decides and says
 //! what it did as an [`Outcome`]; `run`, the queue loop, keeps all the books (counts per
