@@ -201,4 +201,4 @@ fn check_duplicates(vertices: &[DVec3]) -> Result<(), PlcError> {
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -2,37 +2,9 @@
 
 use super::*;
 
-/// The unit cube as a PLC (six quadrilateral facets).
-fn cube_input() -> crate::plc::PlcInput {
-    let vertices = (0..8)
-        .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, (i >> 2) as f64))
-        .collect();
-    let quads = [
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ];
-    crate::plc::PlcInput {
-        vertices,
-        facets: quads
-            .iter()
-            .map(|q| crate::plc::Facet {
-                polygons: vec![q.to_vec()],
-                hole_points: vec![],
-                hole_polygons: vec![],
-                marker: 1,
-            })
-            .collect(),
-        ..Default::default()
-    }
-}
-
 /// The unit cube meshed to a conforming boundary and marked: its domain and regions.
 fn settled_cube() -> (Domain, Regions) {
-    let input = cube_input();
+    let input = crate::plc::tests::unit_cube();
     let plc = crate::plc::validate(&input).unwrap();
     let mut dom = Domain::new(&input, &plc).unwrap();
     dom.set_input_angles(&plc, f64::INFINITY);
@@ -156,7 +128,7 @@ fn refusals_are_counted_and_cascades_remembered() {
 /// input vertices are exact: the predicates see their flatness.)
 #[test]
 fn flat_by_construction_names_collinear_and_coplanar_tets() {
-    let input = cube_input();
+    let input = crate::plc::tests::unit_cube();
     let plc = crate::plc::validate(&input).unwrap();
     let mut dom = Domain::new(&input, &plc).unwrap();
     assert_eq!(
