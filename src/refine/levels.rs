@@ -161,6 +161,11 @@ impl Picker {
         }
     }
 
+    /// The sliver screen for these bounds (the cell level classifies with it too).
+    pub fn screen(&self) -> &SliverScreen {
+        &self.screen
+    }
+
     /// A uniformly random point of the ball of radius `delta * r` around `centre`.
     pub fn in_ball(&mut self, centre: DVec3, r: f64) -> DVec3 {
         centre + random_in_unit_ball(&mut self.rng) * (self.delta * r)

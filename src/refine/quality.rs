@@ -19,7 +19,7 @@ use super::plc_level::Boundary;
 use super::recover::Settled;
 use super::{MeshError, Params, Spacing};
 use crate::delaunay::{Cavity, Probe};
-use crate::geom::screen::{longest_edge_direct as longest_edge, sliver_measures, SliverScreen};
+use crate::geom::screen::{longest_edge_direct as longest_edge, sliver_measures};
 use crate::geom::{circum_offset_crossed, circumsphere, insphere, orient3d};
 use glam::DVec3;
 use rand::SeedableRng;
@@ -89,8 +89,6 @@ pub struct Refiner<'a> {
     pub stop_reason: Option<String>,
     /// The bounding box of the input vertices.
     domain_box: BoundingBox,
-    /// Clears most good tets from squared measures alone (`geom::screen`).
-    screen: SliverScreen,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -141,7 +139,6 @@ impl<'a> Refiner<'a> {
             futile: FxHashSet::default(),
             stop_reason: None,
             domain_box: BoundingBox { lo, hi },
-            screen: SliverScreen::new(params.sigma0, params.min_dihedral),
         }
     }
 
@@ -224,7 +221,7 @@ impl<'a> Refiner<'a> {
             wu.length_squared(),
             uv.length_squared(),
         ];
-        if self.screen.clears(det, e, l2, n) {
+        if self.picker.screen().clears(det, e, l2, n) {
             return Ok(None);
         }
         let (sigma, max_cos_dihedral) = sliver_measures(a, b, c, d, l2);
