@@ -28,7 +28,7 @@ pub use volume::VolumeCriteria;
 use super::curves::{Curve, FeatureCurves};
 use crate::delaunay::tables::FACE;
 use crate::delaunay::{Cavity, Delaunay, Inserted, Probe, INFINITE};
-use crate::geom::{circumcenter, tri_circumcenter};
+use crate::geom::tri_circumcenter;
 use crate::refine::outcome::{BoundaryKind, Outcome, Refusal};
 use crate::refine::{MeshError, Spacing};
 use crate::surface::oracle::{Crossing, SurfaceOracle};
@@ -947,11 +947,6 @@ impl SurfaceMesher<'_> {
 
 fn centroid(dt: &Delaunay, f: [u32; 3]) -> DVec3 {
     f.iter().map(|&v| dt.point(v)).sum::<DVec3>() / 3.0
-}
-
-fn circumcenter_of(dt: &Delaunay, tv: [u32; 4]) -> Option<DVec3> {
-    let [a, b, c, d] = tv.map(|v| dt.point(v));
-    circumcenter(a, b, c, d)
 }
 
 /// Eight points far around the surface, so that every face near it has two finite tets.

@@ -90,6 +90,8 @@ pub struct SurfaceOracle {
     grid: Occupancy,
     /// Triangles with three collinear corners take no part in exact queries.
     flat: Vec<bool>,
+    /// Per triangle: its [`Frame`] (None when it has no area to speak of).
+    frames: Vec<Option<Frame>>,
     pad: f64,
     diagonal: f64,
 }
@@ -123,6 +125,7 @@ impl SurfaceOracle {
             } else {
                 Occupancy::empty()
             },
+            frames: corners.iter().map(|&c| Frame::of(c)).collect(),
             corners,
             pieces,
             flat: (0..n).map(|t| is_flat(surface.corners(t))).collect(),
@@ -271,10 +274,7 @@ impl SurfaceOracle {
     /// found within `r` (or the nearest one): consecutive queries at nearby points mostly end
     /// at the first test.
     pub fn distance_beyond_hinted(&self, p: DVec3, r: f64, hint: &mut Option<u32>) -> Option<f64> {
-        let within = |t: u32| {
-            let [a, b, c] = self.corners[t as usize];
-            (closest_on_triangle(p, a, b, c) - p).length() <= r
-        };
+        let within = |t: u32| self.within(t, p, r);
         if let Some(h) = hint.filter(|&t| (t as usize) < self.corners.len()) {
             if within(h) {
                 return None;
@@ -287,6 +287,19 @@ impl SurfaceOracle {
             {
                 *hint = Some(n);
                 return None;
+            }
+            // Or a neighbour's neighbour (a run of samples crossing a vertex of the last one).
+            for n in self.neighbours[h as usize] {
+                if n == NO_NEIGHBOUR {
+                    continue;
+                }
+                if let Some(&m) = self.neighbours[n as usize]
+                    .iter()
+                    .find(|&&m| m != NO_NEIGHBOUR && m != h && within(m))
+                {
+                    *hint = Some(m);
+                    return None;
+                }
             }
         }
         let mut stack = [0usize; 128];
@@ -322,6 +335,22 @@ impl SurfaceOracle {
         let closest = self.closest(p)?;
         *hint = Some(closest.triangle);
         Some(closest.distance)
+    }
+
+    /// Whether triangle `t` comes within `r` of `p`: through its plane when p lies over it or
+    /// farther than `r` from the plane (the common cases), else through its closest point.
+    pub(crate) fn within(&self, t: u32, p: DVec3, r: f64) -> bool {
+        let [a, b, c] = self.corners[t as usize];
+        if let Some(frame) = &self.frames[t as usize] {
+            let height = frame.normal.dot(p - a);
+            if height.abs() > r {
+                return false;
+            }
+            if frame.over(p, [a, b, c]) {
+                return true;
+            }
+        }
+        (closest_on_triangle(p, a, b, c) - p).length() <= r
     }
 
     /// Every triangle the closed segment [p, q] meets, ordered by parameter then triangle id.
@@ -913,6 +942,37 @@ fn segment_hits_box_axis_parallel(bx: &Aabb, s: &Slab) -> bool {
         }
     }
     true
+}
+
+/// A triangle's unit normal and, per edge, the in-plane direction across it towards the
+/// triangle: the distance to its plane, and whether a point lies over it, by dot products.
+#[derive(Debug, Clone, Copy)]
+struct Frame {
+    normal: DVec3,
+    /// Edge i runs from corner i to corner i + 1.
+    inward: [DVec3; 3],
+}
+
+impl Frame {
+    fn of([a, b, c]: [DVec3; 3]) -> Option<Frame> {
+        let n = (b - a).cross(c - a);
+        let len = n.length();
+        // Too thin for the plane to be well defined: the closest point decides.
+        if len.is_nan() || len <= 1e-12 * (b - a).length_squared().max((c - a).length_squared()) {
+            return None;
+        }
+        let normal = n / len;
+        Some(Frame {
+            normal,
+            inward: [b - a, c - b, a - c].map(|e| normal.cross(e)),
+        })
+    }
+
+    /// Whether p's projection onto the plane lies in the triangle with `corners` (then the
+    /// plane's distance is the triangle's).
+    fn over(&self, p: DVec3, corners: [DVec3; 3]) -> bool {
+        (0..3).all(|i| self.inward[i].dot(p - corners[i]) >= 0.0)
+    }
 }
 
 /// The point of triangle (a, b, c) nearest to p (Ericson, Real-Time Collision Detection 5.1.5).

@@ -219,6 +219,41 @@ fn hinted_distance_queries_match_plain_ones() {
     }
 }
 
+/// The plane shortcuts of the "within r of a triangle" test (far from the plane, or over the
+/// triangle) answer as the closest point does, on fat, thin and needle triangles, away from
+/// ties at the rounding level.
+#[test]
+fn triangle_within_test_matches_the_closest_point() {
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let unit =
+        |rng: &mut ChaCha8Rng| DVec3::new(rng.gen(), rng.gen(), rng.gen()) * 2.0 - DVec3::ONE;
+    let mut triangles = vec![];
+    for k in 0..300 {
+        let (a, b) = (unit(&mut rng), unit(&mut rng));
+        // Every third triangle thin: its apex close to the line through a and b.
+        let thin = [1.0, 1e-3, 1e-9][k % 3];
+        triangles.push([a, b, a + (b - a) * 0.3 + unit(&mut rng) * thin]);
+    }
+    let vertices: Vec<DVec3> = triangles.iter().flatten().copied().collect();
+    let ids = (0..triangles.len() as u32)
+        .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+        .collect();
+    let s = InputSurface::from_triangles(vertices, ids);
+    let o = SurfaceOracle::for_distances(&s);
+    let (mut over, mut near) = (0, 0);
+    for (t, &[a, b, c]) in triangles.iter().enumerate() {
+        for _ in 0..40 {
+            let p = (a + b + c) / 3.0 + unit(&mut rng) * 0.8;
+            let d = (closest_on_triangle(p, a, b, c) - p).length();
+            let r = d * [0.5, 0.99, 1.01, 2.0][rng.gen_range(0..4)];
+            assert_eq!(o.within(t as u32, p, r), d <= r, "triangle {t}, {p}, r {r}");
+            over += usize::from(d <= r);
+            near += usize::from((d - r).abs() < 0.02 * d);
+        }
+    }
+    assert!(over > 3000 && near > 3000, "{over} {near}");
+}
+
 /// Every triangle of `s` the segment [p, q] meets, by testing them all.
 fn brute_crossings(s: &InputSurface, p: DVec3, q: DVec3) -> Vec<u32> {
     (0..s.triangles.len() as u32)

@@ -8,28 +8,70 @@
 //! its proper crossings says whether the side changes from one tet to the other (a ray decides
 //! where a crossing is not proper or a circumcentre is missing).
 
-use super::{circumcenter_of, key3, Queued, Restricted, SurfaceMesher};
+use super::{key3, Queued, Restricted, SurfaceMesher};
 use crate::delaunay::tables::FACE;
-use crate::delaunay::INFINITE;
+use crate::delaunay::{Delaunay, INFINITE};
+use crate::geom::circumsphere;
 use crate::surface::oracle::Side;
 use glam::DVec3;
 use rustc_hash::FxHashMap;
 
 #[derive(Default)]
 pub(super) struct Tracking {
-    /// Per tet id: its circumcentre lies inside the surface.
-    pub inside: Vec<bool>,
-    /// Per tet id: its circumcentre (None: flat or infinite).
-    pub centre: Vec<Option<DVec3>>,
+    /// Per tet id.
+    pub tets: Vec<TetInfo>,
     /// The restricted facets (sorted vertices): surface centre, surface-ball radius and the
     /// input triangle the centre lies on.
     pub restricted: FxHashMap<[u32; 3], (DVec3, f64, u32)>,
 }
 
+/// What is tracked of one tet, side by side: each insertion reads it for the tets around its
+/// cavity, and the cell level for the tets it looks at.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct TetInfo {
+    centre: DVec3,
+    /// Negative when the tet has no circumsphere (flat or infinite).
+    radius: f64,
+    /// The circumcentre lies inside the surface (false without one).
+    inside: bool,
+}
+
+impl Default for TetInfo {
+    fn default() -> Self {
+        TetInfo {
+            centre: DVec3::ZERO,
+            radius: -1.0,
+            inside: false,
+        }
+    }
+}
+
+impl TetInfo {
+    /// Tet `tv`'s circumsphere (`geom::circumsphere` of its vertices in their order), side
+    /// not known yet.
+    fn of(dt: &Delaunay, tv: [u32; 4]) -> TetInfo {
+        if tv.contains(&INFINITE) {
+            return TetInfo::default();
+        }
+        let [a, b, c, d] = tv.map(|v| dt.point(v));
+        match circumsphere(a, b, c, d) {
+            Some((centre, radius)) => TetInfo {
+                centre,
+                radius,
+                inside: false,
+            },
+            None => TetInfo::default(),
+        }
+    }
+
+    fn centre(&self) -> Option<DVec3> {
+        (self.radius >= 0.0).then_some(self.centre)
+    }
+}
+
 /// Every tet's side and every restricted facet, from one pass over the triangulation.
 struct Classified {
-    inside: Vec<bool>,
-    centre: Vec<Option<DVec3>>,
+    tets: Vec<TetInfo>,
     restricted: Vec<Restricted>,
 }
 
@@ -38,8 +80,7 @@ impl SurfaceMesher<'_> {
     pub(super) fn start_tracking(&mut self) {
         let classified = self.classify_tets();
         self.track = Tracking {
-            inside: classified.inside,
-            centre: classified.centre,
+            tets: classified.tets,
             restricted: classified
                 .restricted
                 .iter()
@@ -62,12 +103,19 @@ impl SurfaceMesher<'_> {
 
     /// Whether tet `t`'s circumcentre lies inside the surface.
     pub(super) fn is_inside(&self, t: u32) -> bool {
-        self.track.inside.get(t as usize).copied().unwrap_or(false)
+        self.track.tets.get(t as usize).is_some_and(|i| i.inside)
     }
 
     /// The circumcentre of tet `t` (None when flat or infinite).
     pub(super) fn centre_of(&self, t: u32) -> Option<DVec3> {
-        self.track.centre.get(t as usize).copied().flatten()
+        self.track.tets.get(t as usize).and_then(TetInfo::centre)
+    }
+
+    /// The circumcentre and circumradius of live tet `t` (None when flat or infinite), as
+    /// `geom::circumsphere` gives them.
+    pub(super) fn sphere_of(&self, t: u32) -> Option<(DVec3, f64)> {
+        let info = self.track.tets.get(t as usize)?;
+        info.centre().map(|c| (c, info.radius))
     }
 
     /// Whether a tet with circumcentre `centre` is inside, given the side of the tet across a
@@ -98,41 +146,31 @@ impl SurfaceMesher<'_> {
             }
         }
         let cap = self.dt.tet_capacity();
-        if track.inside.len() < cap {
-            track.inside.resize(cap, false);
-            track.centre.resize(cap, None);
+        if track.tets.len() < cap {
+            track.tets.resize(cap, TetInfo::default());
         }
         for &t in created {
-            let tv = self.dt.tet(t);
-            track.centre[t as usize] = if tv.contains(&INFINITE) {
-                None
-            } else {
-                circumcenter_of(&self.dt, tv)
-            };
+            track.tets[t as usize] = TetInfo::of(&self.dt, self.dt.tet(t));
         }
         let mut found = vec![];
         for &t in created {
             let tv = self.dt.tet(t);
             let nb = self.dt.neighbors(t);
-            let c = track.centre[t as usize];
+            let c = track.tets[t as usize].centre();
             for i in 0..4 {
                 let n = nb[i];
                 let outer = tv[i] == new_vertex;
                 if !outer && n < t {
                     continue; // an inner face of the new star, seen from the other tet
                 }
-                let cn = if self.dt.tet(n).contains(&INFINITE) {
-                    None
-                } else {
-                    track.centre[n as usize]
-                };
-                let (crossings, parity) = match (c, cn) {
+                // Infinite tets have no centre: the neighbour's record alone says it.
+                let other = track.tets[n as usize];
+                let (crossings, parity) = match (c, other.centre()) {
                     (Some(c), Some(cn)) => self.oracle.crossings_and_parity(c, cn),
                     _ => (vec![], None),
                 };
                 if outer {
-                    track.inside[t as usize] =
-                        self.side_across(track.inside[n as usize], c, parity);
+                    track.tets[t as usize].inside = self.side_across(other.inside, c, parity);
                 }
                 let face = FACE[i].map(|k| tv[k]);
                 if let Some(r) = Self::facet_from(&self.dt, face, crossings) {
@@ -158,18 +196,17 @@ impl SurfaceMesher<'_> {
     fn classify_tets(&self) -> Classified {
         let cap = self.dt.tet_capacity();
         let mut out = Classified {
-            inside: vec![false; cap],
-            centre: vec![None; cap],
+            tets: vec![TetInfo::default(); cap],
             restricted: vec![],
         };
         let mut reached = vec![false; cap];
         let mut done = vec![false; cap];
         let mut queue = std::collections::VecDeque::new();
         for t in self.dt.finite_tet_ids() {
-            out.centre[t as usize] = circumcenter_of(&self.dt, self.dt.tet(t));
+            out.tets[t as usize] = TetInfo::of(&self.dt, self.dt.tet(t));
             if queue.is_empty() {
-                if let Some(c) = out.centre[t as usize] {
-                    out.inside[t as usize] = self.oracle.side(c) != Side::Outside;
+                if let Some(c) = out.tets[t as usize].centre() {
+                    out.tets[t as usize].inside = self.oracle.side(c) != Side::Outside;
                     reached[t as usize] = true;
                     queue.push_back(t);
                 }
@@ -182,14 +219,15 @@ impl SurfaceMesher<'_> {
                 if done[n as usize] || !self.dt.is_finite(n) {
                     continue;
                 }
-                let (c, cn) = (out.centre[t as usize], out.centre[n as usize]);
+                let (c, cn) = (out.tets[t as usize].centre(), out.tets[n as usize].centre());
                 let (crossings, parity) = match (c, cn) {
                     (Some(c), Some(cn)) => self.oracle.crossings_and_parity(c, cn),
                     _ => (vec![], None),
                 };
                 if !reached[n as usize] {
                     reached[n as usize] = true;
-                    out.inside[n as usize] = self.side_across(out.inside[t as usize], cn, parity);
+                    out.tets[n as usize].inside =
+                        self.side_across(out.tets[t as usize].inside, cn, parity);
                     queue.push_back(n);
                 }
                 let face = FACE[i].map(|k| tv[k]);

@@ -15,7 +15,6 @@ use super::facet_level::Encroached;
 use super::{Loc, SurfaceMesher};
 use crate::delaunay::tables::FACE;
 use crate::delaunay::{Inserted, Probe, INFINITE};
-use crate::geom::circumsphere;
 use crate::geom::screen::{shortest_edge_sq, sliver_measures};
 use crate::refine::levels::{pick_in_ball, Conflict, FacetLevel, Picker, Request, SliverBounds};
 use crate::refine::{AutoSpacing, Spacing};
@@ -175,8 +174,7 @@ impl SurfaceMesher<'_> {
         if tv.iter().any(|&v| near_small(v)) {
             return None;
         }
-        let [a, b, c, d] = tv.map(|v| self.dt.point(v));
-        let (centre, r) = circumsphere(a, b, c, d)?;
+        let (centre, r) = self.sphere_of(t)?;
         let f = match &vol.spacing {
             Some(s) => s.at(centre),
             None => self.spacing.at(centre),
@@ -184,6 +182,7 @@ impl SurfaceMesher<'_> {
         if r > vol.crit.size_factor * f {
             return Some(SIZE);
         }
+        let [a, b, c, d] = tv.map(|v| self.dt.point(v));
         let l2 = shortest_edge_sq(a, b, c, d);
         if r * r > vol.crit.rho0 * vol.crit.rho0 * l2 {
             return Some(RATIO);
@@ -238,8 +237,7 @@ impl SurfaceMesher<'_> {
 
     fn refine_cell(&mut self, t: u32) {
         let tv = self.dt.tet(t);
-        let [a, b, c, d] = tv.map(|v| self.dt.point(v));
-        let Some((centre, r)) = circumsphere(a, b, c, d) else {
+        let Some((centre, r)) = self.sphere_of(t) else {
             return;
         };
         let Probe::Cavity(cavity) = self.dt.probe(centre, Some(t)) else {
