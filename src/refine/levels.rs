@@ -97,6 +97,17 @@ pub(crate) struct Picker {
     pub slivers: SliverBounds,
     /// Clears most new tets from squared measures alone (`geom::screen`).
     screen: SliverScreen,
+    /// When to stop drawing before `max_tries` (None: never).
+    give_up: Option<GiveUp>,
+}
+
+/// Stop drawing once `after` draws have left the best candidate with at least `n_small`
+/// small slivers: the rest of the picking ball is then mostly sliver-making too, and the
+/// remaining draws rarely find a sliver-free point (see `APPROX_GIVE_UP`).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct GiveUp {
+    pub after: usize,
+    pub n_small: usize,
 }
 
 /// What a sliver is: sigma = V / L^3 below sigma0, or a dihedral angle below the bound.
@@ -158,7 +169,22 @@ impl Picker {
             b,
             slivers: SliverBounds::new(sigma0, min_dihedral_deg),
             screen: SliverScreen::new(sigma0, min_dihedral_deg),
+            give_up: None,
         }
+    }
+
+    /// The picker, drawing no more once `give_up` says so.
+    pub fn giving_up(self, give_up: GiveUp) -> Picker {
+        Picker {
+            give_up: Some(give_up),
+            ..self
+        }
+    }
+
+    /// Whether to stop after `draws` draws with `best` the best candidate's score so far.
+    fn gives_up(&self, draws: usize, best: Option<&Score>) -> bool {
+        self.give_up
+            .is_some_and(|g| draws >= g.after && best.is_some_and(|b| b.n_small >= g.n_small))
     }
 
     /// The sliver screen for these bounds (the cell level classifies with it too).
@@ -270,7 +296,10 @@ pub(crate) fn pick_in_ball<F: FacetLevel + ?Sized>(
         }
     }
     if best.as_ref().is_none_or(|b| b.score.n_small > 0) {
-        for _ in 0..picker.max_tries {
+        for draws in 0..picker.max_tries {
+            if picker.gives_up(draws, best.as_ref().map(|b: &Candidate| &b.score)) {
+                break;
+            }
             let p = picker.in_ball(centre, r);
             if try_candidate(level, picker, p, r, Some(hint), true, &mut best) {
                 break;
@@ -291,5 +320,33 @@ pub(crate) fn random_in_unit_ball(rng: &mut impl Rng) -> DVec3 {
         if v.length_squared() <= 1.0 {
             return v;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+
+    #[test]
+    fn picker_gives_up_only_after_enough_draws_with_enough_small_slivers() {
+        let picker = || Picker::new(ChaCha8Rng::seed_from_u64(1), 0.3, 20, 4.0, 0.02, 18.0);
+        let score = |n_small| Score {
+            n_small,
+            margin: 0.1,
+        };
+        // Without a rule it never stops early.
+        assert!(!picker().gives_up(19, Some(&score(9))));
+        let p = picker().giving_up(GiveUp {
+            after: 5,
+            n_small: 3,
+        });
+        assert!(!p.gives_up(4, Some(&score(9))), "too few draws");
+        assert!(p.gives_up(5, Some(&score(3))));
+        assert!(
+            !p.gives_up(5, Some(&score(2))),
+            "a sliver-free point is still likely"
+        );
+        assert!(!p.gives_up(7, None), "no candidate kept yet");
     }
 }

@@ -16,7 +16,9 @@ use super::{Loc, SurfaceMesher};
 use crate::delaunay::tables::FACE;
 use crate::delaunay::{Inserted, Probe, INFINITE};
 use crate::geom::screen::{shortest_edge_sq, sliver_measures};
-use crate::refine::levels::{pick_in_ball, Conflict, FacetLevel, Picker, Request, SliverBounds};
+use crate::refine::levels::{
+    pick_in_ball, Conflict, FacetLevel, GiveUp, Picker, Request, SliverBounds,
+};
 use crate::refine::{AutoSpacing, Spacing};
 use glam::DVec3;
 use rand::SeedableRng;
@@ -51,6 +53,15 @@ const SIZE: usize = 2;
 /// left as it is.
 const MAX_CELL_DEFERRALS: u8 = 4;
 
+/// The cell level stops drawing from a picking ball after 5 draws that all leave at least 3
+/// small slivers. Measured with 20 draws (joint, fandisk, elephant): of such balls the
+/// remaining 15 draws found a sliver-free point in 1-5%, against 40-60% of the balls whose
+/// best had one small sliver; the hopeless balls took most of the draws.
+const APPROX_GIVE_UP: GiveUp = GiveUp {
+    after: 5,
+    n_small: 3,
+};
+
 pub(super) struct VolumeState {
     crit: VolumeCriteria,
     slivers: SliverBounds,
@@ -78,14 +89,17 @@ impl SurfaceMesher<'_> {
         self.vol = Some(Box::new(VolumeState {
             crit,
             slivers: SliverBounds::new(crit.sigma0, crit.min_dihedral_deg),
-            picker: Some(Picker::new(
-                ChaCha8Rng::seed_from_u64(crit.seed ^ 0x766f_6c75_6d65),
-                crit.delta,
-                crit.max_tries,
-                crit.b,
-                crit.sigma0,
-                crit.min_dihedral_deg,
-            )),
+            picker: Some(
+                Picker::new(
+                    ChaCha8Rng::seed_from_u64(crit.seed ^ 0x766f_6c75_6d65),
+                    crit.delta,
+                    crit.max_tries,
+                    crit.b,
+                    crit.sigma0,
+                    crit.min_dihedral_deg,
+                )
+                .giving_up(APPROX_GIVE_UP),
+            ),
             queues: Default::default(),
             deferrals: FxHashMap::default(),
             spacing,
