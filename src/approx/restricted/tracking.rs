@@ -108,7 +108,7 @@ impl SurfaceMesher<'_> {
 
     /// The circumcentre of tet `t` (None when flat or infinite).
     pub(super) fn centre_of(&self, t: u32) -> Option<DVec3> {
-        self.track.tets.get(t as usize).and_then(TetInfo::centre)
+        self.sphere_of(t).map(|(centre, _)| centre)
     }
 
     /// The circumcentre and circumradius of live tet `t` (None when flat or infinite), as
