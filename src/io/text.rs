@@ -8,6 +8,7 @@
 use super::IoError;
 use crate::mesh::TetMesh;
 use glam::DVec3;
+use std::borrow::Cow;
 use std::fmt;
 use std::path::Path;
 
@@ -437,25 +438,58 @@ pub(crate) fn write_int_line(
 }
 
 /// Formats a float so that parsing it back gives the same bits, as short as possible:
-/// integral values below 1e15 without a fraction (`3`, `-0`), everything else with Rust's
-/// shortest round-trip representation (`0.1`, `1e-7`, `1.2345678901234567e300`).
-/// Non-finite values print as `nan`, `inf`, `-inf`.
+/// integral values below 1e15 without a fraction (`3`, `-0`), everything else with the
+/// shortest round-trip representation in the notation of Rust's `{:?}` (`0.1`, `1e-7`,
+/// `1.2345678901234567e300`). Non-finite values print as `nan`, `inf`, `-inf`.
 pub(crate) struct F(pub f64);
 
 impl fmt::Display for F {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let x = self.0;
-        if x.is_nan() {
-            f.write_str("nan")
-        } else if x.is_infinite() {
-            f.write_str(if x > 0.0 { "inf" } else { "-inf" })
-        } else if x.fract() == 0.0 && x.abs() < 1e15 {
-            // Display of an integral f64 prints no fraction and keeps the sign of -0.
-            write!(f, "{x}")
-        } else {
-            write!(f, "{x:?}")
-        }
+        f.write_str(&float_text(self.0, &mut zmij::Buffer::new()))
     }
+}
+
+/// Below this magnitude `{:?}` switches to exponent notation.
+const SHORTEST_DECIMAL: f64 = 1e-4;
+
+/// The text of [`F`], in `buf` where it can be.
+pub(crate) fn float_text(x: f64, buf: &mut zmij::Buffer) -> Cow<'_, str> {
+    if x.is_nan() {
+        "nan".into()
+    } else if x.is_infinite() {
+        if x > 0.0 { "inf" } else { "-inf" }.into()
+    } else if (SHORTEST_DECIMAL..1e16).contains(&x.abs()) || x == 0.0 {
+        // zmij prints the same shortest digits as `{:?}` here (it may pick the other one of
+        // two equally short, equally close decimals), several times faster; it prints
+        // integral values with ".0" (`3.0`, `-0.0`), which Display leaves off.
+        let text = buf.format_finite(x);
+        if x.fract() == 0.0 && x.abs() < 1e15 {
+            text.strip_suffix(".0").unwrap_or(text).into()
+        } else {
+            text.into()
+        }
+    } else {
+        // Exponent notation, which zmij writes differently (`1e+300`).
+        format!("{x:?}").into()
+    }
+}
+
+/// Writes `values` as one line of [`F`] texts, separated by spaces (see [`write_int_line`]).
+pub(crate) fn write_float_line(
+    w: &mut dyn std::io::Write,
+    line: &mut Vec<u8>,
+    values: &[f64],
+) -> std::io::Result<()> {
+    line.clear();
+    let mut buf = zmij::Buffer::new();
+    for (k, &v) in values.iter().enumerate() {
+        if k > 0 {
+            line.push(b' ');
+        }
+        line.extend_from_slice(float_text(v, &mut buf).as_bytes());
+    }
+    line.push(b'\n');
+    w.write_all(line)
 }
 
 /// [`check_mesh`] for the `format_*` functions, which return `std::io::Error`.

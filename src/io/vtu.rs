@@ -17,8 +17,8 @@
 //! ignored. Errors carry the line of the offending array.
 
 use super::text::{
-    check_mesh, check_mesh_io, create, err_at, err_file, parse_f64, read_text, to_u32, with_path,
-    write_err, F,
+    check_mesh, check_mesh_io, create, err_at, err_file, float_text, parse_f64, read_text, to_u32,
+    with_path, write_err, write_float_line, write_int_line,
 };
 use super::{CellField, IoError};
 use crate::mesh::TetMesh;
@@ -55,23 +55,31 @@ fn xml_escape(s: &str) -> String {
     out
 }
 
-/// Writes items `per_line` to a line.
+/// Writes items `per_line` to a line, each appended to the line by `text`.
 fn write_rows<W: Write, T>(
     w: &mut W,
     items: &[T],
     per_line: usize,
-    mut item: impl FnMut(&mut W, &T) -> std::io::Result<()>,
+    mut text: impl FnMut(&mut Vec<u8>, &T),
 ) -> std::io::Result<()> {
+    let mut line = Vec::new();
     for chunk in items.chunks(per_line) {
+        line.clear();
         for (i, x) in chunk.iter().enumerate() {
             if i > 0 {
-                w.write_all(b" ")?;
+                line.push(b' ');
             }
-            item(w, x)?;
+            text(&mut line, x);
         }
-        w.write_all(b"\n")?;
+        line.push(b'\n');
+        w.write_all(&line)?;
     }
     Ok(())
+}
+
+/// Appends integer `x` to a line.
+fn push_int(line: &mut Vec<u8>, x: impl itoa::Integer) {
+    line.extend_from_slice(itoa::Buffer::new().format(x).as_bytes());
 }
 
 /// Writes `mesh` in `.vtu` format to any writer.
@@ -100,8 +108,9 @@ pub fn format_vtu<W: Write>(
         w,
         "<DataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\" format=\"ascii\">"
     )?;
+    let mut line = Vec::new();
     for p in &mesh.vertices {
-        writeln!(w, "{} {} {}", F(p.x), F(p.y), F(p.z))?;
+        write_float_line(w, &mut line, &p.to_array())?;
     }
     writeln!(w, "</DataArray>\n</Points>\n<Cells>")?;
     writeln!(
@@ -109,7 +118,7 @@ pub fn format_vtu<W: Write>(
         "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">"
     )?;
     for t in &mesh.tets {
-        writeln!(w, "{} {} {} {}", t[0], t[1], t[2], t[3])?;
+        write_int_line(w, &mut line, &t.map(i64::from))?;
     }
     writeln!(w, "</DataArray>")?;
     writeln!(
@@ -117,21 +126,21 @@ pub fn format_vtu<W: Write>(
         "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">"
     )?;
     let offsets: Vec<usize> = (1..=nt).map(|i| 4 * i).collect();
-    write_rows(w, &offsets, 16, |w, o| write!(w, "{o}"))?;
+    write_rows(w, &offsets, 16, |line, &o| push_int(line, o))?;
     writeln!(w, "</DataArray>")?;
     writeln!(
         w,
         "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">"
     )?;
     let types = vec![10u8; nt];
-    write_rows(w, &types, 32, |w, t| write!(w, "{t}"))?;
+    write_rows(w, &types, 32, |line, &t| push_int(line, t))?;
     writeln!(w, "</DataArray>\n</Cells>")?;
     writeln!(w, "<CellData Scalars=\"region\">")?;
     writeln!(
         w,
         "<DataArray type=\"Int32\" Name=\"region\" format=\"ascii\">"
     )?;
-    write_rows(w, &mesh.tet_regions, 16, |w, r| write!(w, "{r}"))?;
+    write_rows(w, &mesh.tet_regions, 16, |line, &r| push_int(line, r))?;
     writeln!(w, "</DataArray>")?;
     for f in cell_fields {
         writeln!(
@@ -139,7 +148,10 @@ pub fn format_vtu<W: Write>(
             "<DataArray type=\"Float64\" Name=\"{}\" format=\"ascii\">",
             xml_escape(f.name)
         )?;
-        write_rows(w, f.values, 8, |w, x| write!(w, "{}", F(*x)))?;
+        let mut buf = zmij::Buffer::new();
+        write_rows(w, f.values, 8, |line, &x| {
+            line.extend_from_slice(float_text(x, &mut buf).as_bytes())
+        })?;
         writeln!(w, "</DataArray>")?;
     }
     writeln!(w, "</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>")
