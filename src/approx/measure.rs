@@ -4,6 +4,7 @@
 
 use super::curves::point_segment_distance;
 use super::Remeshed;
+use crate::delaunay::hilbert::hilbert_sort;
 use crate::geom::{min_max_dihedral, radius_edge_ratio, volume};
 use crate::mesh::TetMesh;
 use crate::refine::{Params, SurfaceReport};
@@ -77,8 +78,20 @@ pub fn surface_report(r: &Remeshed, mesh: &TetMesh) -> SurfaceReport {
     }
 }
 
+/// The output boundary, its triangles along a Hilbert curve: consecutive samples then lie
+/// close together, so the last triangle found mostly holds the next one too (the mesh's own
+/// order jumps about) and the distance queries keep their memory warm. The samples, and so
+/// the distances, do not depend on the order.
 fn output_surface(mesh: &TetMesh) -> InputSurface {
-    InputSurface::from_triangles(mesh.vertices.clone(), mesh.boundary.clone())
+    let centroids: Vec<DVec3> = mesh
+        .boundary
+        .iter()
+        .map(|t| t.iter().map(|&v| mesh.vertices[v as usize]).sum::<DVec3>() / 3.0)
+        .collect();
+    let mut order: Vec<u32> = (0..mesh.boundary.len() as u32).collect();
+    hilbert_sort(&centroids, &mut order);
+    let triangles = order.iter().map(|&t| mesh.boundary[t as usize]).collect();
+    InputSurface::from_triangles(mesh.vertices.clone(), triangles)
 }
 
 /// Largest distance from a sample of an input feature edge to the nearest output feature edge.

@@ -275,10 +275,14 @@ impl SurfaceOracle {
     /// at the first test.
     pub fn distance_beyond_hinted(&self, p: DVec3, r: f64, hint: &mut Option<u32>) -> Option<f64> {
         let within = |t: u32| self.within(t, p, r);
-        if let Some(h) = hint.filter(|&t| (t as usize) < self.corners.len()) {
-            if within(h) {
-                return None;
-            }
+        if let Some(h0) = hint.filter(|&t| (t as usize) < self.corners.len()) {
+            let h = match self.walk_towards(h0, p, r) {
+                Walked::Within(t) => {
+                    *hint = Some(t);
+                    return None;
+                }
+                Walked::Stopped(t) => t,
+            };
             // The next point of a run of samples mostly lies over a neighbour of the last
             // triangle found.
             if let Some(&n) = self.neighbours[h as usize]
@@ -335,6 +339,34 @@ impl SurfaceOracle {
         let closest = self.closest(p)?;
         *hint = Some(closest.triangle);
         Some(closest.distance)
+    }
+
+    /// From triangle `t`, steps across an edge `p` lies beyond while the triangle reached is not
+    /// within `r` of p (at most [`WALK_STEPS`] steps): on a surface made of small triangles the
+    /// last triangle found is often a few triangles away from the next point of a run of
+    /// samples, and the walk goes straight there where the rings around `t` try every
+    /// neighbour.
+    fn walk_towards(&self, mut t: u32, p: DVec3, r: f64) -> Walked {
+        let mut last = NO_NEIGHBOUR;
+        for step in 0..=WALK_STEPS {
+            if self.within(t, p, r) {
+                return Walked::Within(t);
+            }
+            let Some(frame) = &self.frames[t as usize] else {
+                break;
+            };
+            let corners = self.corners[t as usize];
+            let Some(edge) = (0..3).find(|&i| frame.inward[i].dot(p - corners[i]) < 0.0) else {
+                // p lies over t, farther than r from its plane: the walk is done.
+                break;
+            };
+            let next = self.neighbours[t as usize][edge];
+            if step == WALK_STEPS || next == NO_NEIGHBOUR || next == last {
+                break;
+            }
+            (last, t) = (t, next);
+        }
+        Walked::Stopped(t)
     }
 
     /// Whether triangle `t` comes within `r` of `p`: through its plane when p lies over it or
@@ -472,6 +504,17 @@ struct OnSurface;
 
 /// See `SurfaceOracle::neighbours`.
 const NO_NEIGHBOUR: u32 = u32::MAX;
+
+/// The most edges [`SurfaceOracle::walk_towards`] crosses.
+const WALK_STEPS: usize = 4;
+
+/// Where a walk over the triangles ended.
+enum Walked {
+    /// At a triangle within the distance.
+    Within(u32),
+    /// At a triangle that is not, the last one reached.
+    Stopped(u32),
+}
 
 /// The triangles across each triangle's edges (`NO_NEIGHBOUR` unless exactly two share it).
 fn edge_neighbours(triangles: &[[u32; 3]]) -> Vec<[u32; 3]> {
