@@ -26,13 +26,13 @@ pub(super) fn hausdorff_samples(surface: &InputSurface) -> Vec<DVec3> {
     samples_per_edge_at_least(surface, spacing, MIN_PIECES)
 }
 
-/// Largest distance from samples of `from` to the surface behind `oracle` (spacing as
-/// [`hausdorff_samples`], by `from`'s own diagonal).
-fn one_sided(from: &InputSurface, oracle: &SurfaceOracle) -> f64 {
+/// Largest distance from `samples` (of one surface, [`hausdorff_samples`]) to the surface
+/// behind `oracle`.
+fn one_sided(samples: &[DVec3], oracle: &SurfaceOracle) -> f64 {
     let mut worst: f64 = 0.0;
     // Consecutive samples come from one triangle: the last triangle found is tried first.
     let mut hint = None;
-    for p in hausdorff_samples(from) {
+    for &p in samples {
         if let Some(d) = oracle.distance_beyond_hinted(p, worst, &mut hint) {
             worst = worst.max(d);
         }
@@ -57,8 +57,8 @@ pub fn surface_report(r: &Remeshed, mesh: &TetMesh) -> SurfaceReport {
         .sum();
     SurfaceReport {
         surface_distance: r.distance,
-        hausdorff_input_to_output: one_sided(&r.surface, &SurfaceOracle::for_distances(&out)),
-        hausdorff_output_to_input: one_sided(&out, &r.oracle),
+        hausdorff_input_to_output: one_sided(&r.input_samples, &SurfaceOracle::for_distances(&out)),
+        hausdorff_output_to_input: one_sided(&hausdorff_samples(&out), &r.oracle),
         feature_distance: feature_distance(r, &mesh.vertices),
         relative_volume_difference: if r.input_volume > 0.0 {
             (out_volume - r.input_volume) / r.input_volume

@@ -55,6 +55,8 @@ const FACET_MIN_ANGLE_DEG: f64 = 30.0;
 /// the new boundary as a PLC.
 pub struct Remeshed {
     pub surface: InputSurface,
+    /// `surface`'s Hausdorff samples (`measure::hausdorff_samples`).
+    pub input_samples: Vec<glam::DVec3>,
     /// The oracle of `surface`.
     pub oracle: SurfaceOracle,
     pub features: Features,
@@ -280,14 +282,20 @@ pub fn remesh(
         seed: params.seed,
     };
     let mesher = SurfaceMesher::new(&surface, &oracle, &curves, &features.patch_of, f, criteria)?;
-    let (b, volume) = mesher.run_with_volume(crit, progress)?;
+    let (mut b, volume) = mesher.run_with_volume(crit, progress)?;
+
     let boundary = boundary_plc(input, &b, &surface, &features);
     let small_corners: Vec<_> = curves
         .small_corners()
         .map(|c| (c.point, c.protect_radius))
         .collect();
     let (small_corner_vertices, vertex_slide) = slides(&b, &curves);
+    let input_samples = b
+        .input_samples
+        .take()
+        .unwrap_or_else(|| measure::hausdorff_samples(&surface));
     let remeshed = Remeshed {
+        input_samples,
         small_corner_vertices,
         vertex_slide,
         input_volume: plc.volume(),

@@ -144,6 +144,8 @@ pub struct Boundary {
     pub feature_edges: Vec<[u32; 2]>,
     /// Why the mesher stopped before every facet was good, if it did.
     pub stop_reason: Option<String>,
+    /// The input's Hausdorff samples if the mesher took them (the report takes the same).
+    pub input_samples: Option<Vec<DVec3>>,
 }
 
 pub struct SurfaceMesher<'a> {
@@ -173,6 +175,8 @@ pub struct SurfaceMesher<'a> {
     vol: Option<Box<volume::VolumeState>>,
     /// The small corners' protecting balls: centre and squared radius.
     small_balls: Vec<(DVec3, f64)>,
+    /// The input's Hausdorff samples (`measure::hausdorff_samples`), once taken.
+    input_samples: std::cell::OnceCell<Vec<DVec3>>,
 }
 
 /// The surface mesh stops (with a reason) at this many times its initial samples: the
@@ -232,6 +236,7 @@ impl<'a> SurfaceMesher<'a> {
             min_length: 1e-9 * diagonal,
             track: tracking::Tracking::default(),
             vol: None,
+            input_samples: std::cell::OnceCell::new(),
             small_balls: curves
                 .small_corners()
                 .map(|c| (c.point, c.protect_radius * c.protect_radius))
@@ -395,7 +400,8 @@ impl<'a> SurfaceMesher<'a> {
         if cancelled {
             return Err(MeshError::Cancelled);
         }
-        let boundary = self.boundary(faces, stop_reason);
+        let mut boundary = self.boundary(faces, stop_reason);
+        boundary.input_samples = self.input_samples.take();
         let mut volume = self.volume_mesh(&boundary)?;
         volume.spacing = self.vol.take().and_then(|v| v.spacing);
         volume.seconds_surface = seconds_surface;
@@ -829,11 +835,14 @@ impl<'a> SurfaceMesher<'a> {
             .collect();
         let extracted = InputSurface::from_triangles(self.dt.points().to_vec(), triangles);
         let near = SurfaceOracle::for_distances(&extracted);
-        let points = super::measure::hausdorff_samples(self.surface);
+        let points = self
+            .input_samples
+            .get_or_init(|| super::measure::hausdorff_samples(self.surface));
         // Consecutive samples come from one input triangle: the last face found is tried first.
         let mut hint = None;
         let mut far: Vec<FaceRef> = points
-            .into_iter()
+            .iter()
+            .copied()
             .filter(|&p| {
                 near.distance_beyond_hinted(p, self.criteria.bound, &mut hint)
                     .is_some()
