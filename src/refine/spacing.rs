@@ -142,6 +142,13 @@ impl AutoSpacing {
                 }
             }
         }
+        // The 26 neighbours of an interior cell as index offsets, and what each step adds.
+        let neighbours = steps.iter().filter(|st| (st.0, st.1, st.2) != (0, 0, 0));
+        let offsets: Vec<isize> = neighbours
+            .clone()
+            .map(|&(di, dj, dk, _)| (di + (dj + dk * ny as i64) * nx as i64) as isize)
+            .collect();
+        let adds: Vec<f64> = neighbours.map(|st| st.3).collect();
         for _ in 0..2 {
             for pass in 0..2 {
                 for kk in 0..nz {
@@ -157,11 +164,9 @@ impl AutoSpacing {
                                 i > 0 && j > 0 && k > 0 && i + 1 < nx && j + 1 < ny && k + 1 < nz;
                             if interior {
                                 // No bounds to check; a plain comparison (no NaN here).
-                                let at = idx(i, j, k) as i64;
-                                for &(di, dj, dk, add) in &steps {
-                                    let x = self.value
-                                        [(at + di + (dj + dk * ny as i64) * nx as i64) as usize]
-                                        + add;
+                                let at = idx(i, j, k);
+                                for (&offset, &add) in offsets.iter().zip(&adds) {
+                                    let x = self.value[at.wrapping_add_signed(offset)] + add;
                                     if x < best {
                                         best = x;
                                     }
