@@ -237,13 +237,15 @@ fn finish(
         let json = serde_json::to_string_pretty(report).map_err(|e| e.to_string())?;
         std::fs::write(path, json).map_err(|e| format!("{}: {e}", path.display()))?;
     }
+    // Every tet measured once, for the .vtu's cell data and the quality table.
+    let per_tet = slivermesh::quality::per_tet(mesh).ok();
     if let Some(path) = output {
-        write_with_quality(path, mesh)?;
+        write_with_quality(path, mesh, per_tet.as_deref())?;
         println!("wrote {}", path.display());
     }
     // Measured on the mesh as written, the table `slivermesh quality` prints for that file.
     let name = output.map_or("the output mesh".to_string(), |p| p.display().to_string());
-    super::quality::report_output(mesh, &name, quality_svg)
+    super::quality::report_output(mesh, &name, quality_svg, per_tet.as_deref())
 }
 
 /// The report's "surface" section (approximate mode), in the style of `Report::table`.
@@ -288,8 +290,12 @@ fn surface_table(s: &SurfaceReport) -> String {
 }
 
 /// Writes the mesh, with per-tet quality as cell data (radius-edge ratio, sigma, min dihedral)
-/// when the format is .vtu.
-pub fn write_with_quality(path: &Path, mesh: &TetMesh) -> Result<(), String> {
+/// when the format is .vtu: from `per_tet` (`quality::per_tet`) when given.
+pub fn write_with_quality(
+    path: &Path,
+    mesh: &TetMesh,
+    per_tet: Option<&[TetQuality]>,
+) -> Result<(), String> {
     // Only .vtu has a place for cell data: measuring every tet for another format is wasted.
     if !path
         .extension()
@@ -297,16 +303,17 @@ pub fn write_with_quality(path: &Path, mesh: &TetMesh) -> Result<(), String> {
     {
         return io::write_mesh(path, mesh, &[]).map_err(|e| e.to_string());
     }
-    let mut rho = Vec::with_capacity(mesh.tets.len());
-    let mut sigma = Vec::with_capacity(mesh.tets.len());
-    let mut dihedral = Vec::with_capacity(mesh.tets.len());
-    for t in &mesh.tets {
-        let [a, b, c, d] = t.map(|v| mesh.vertices[v as usize]);
-        let q = TetQuality::of(a, b, c, d);
-        rho.push(q.rho);
-        sigma.push(q.sigma);
-        dihedral.push(q.min_dihedral);
-    }
+    let measured;
+    let per_tet = match per_tet {
+        Some(q) if q.len() == mesh.tets.len() => q,
+        _ => {
+            measured = slivermesh::quality::per_tet(mesh).map_err(|e| e.to_string())?;
+            &measured
+        }
+    };
+    let rho: Vec<f64> = per_tet.iter().map(|q| q.rho).collect();
+    let sigma: Vec<f64> = per_tet.iter().map(|q| q.sigma).collect();
+    let dihedral: Vec<f64> = per_tet.iter().map(|q| q.min_dihedral).collect();
     let fields = [
         CellField {
             name: "radius_edge_ratio",

@@ -1,6 +1,7 @@
 //! `slivermesh quality MESH`: the quality table and a histogram of any tet mesh we read, an SVG
 //! picture, a side-by-side comparison with another mesh; and the same table for `mesh`.
 
+use slivermesh::geom::TetQuality;
 use slivermesh::io;
 use slivermesh::mesh::TetMesh;
 use slivermesh::quality::{self, MeshQuality, SvgSeries};
@@ -126,8 +127,18 @@ fn file_name(path: &str) -> &str {
 
 /// The `mesh` command's part: the quality table of the mesh it writes (measured on that mesh,
 /// as `slivermesh quality` would), and the picture when `svg` is given.
-pub fn report_output(mesh: &TetMesh, name: &str, svg: Option<&Path>) -> Result<(), String> {
-    let q = match quality::measure(mesh) {
+/// `per_tet`: the tets' measures (`quality::per_tet`) when the caller has them.
+pub fn report_output(
+    mesh: &TetMesh,
+    name: &str,
+    svg: Option<&Path>,
+    per_tet: Option<&[TetQuality]>,
+) -> Result<(), String> {
+    let measured = match per_tet {
+        Some(per_tet) => quality::measure_with(mesh, per_tet),
+        None => quality::measure(mesh),
+    };
+    let q = match measured {
         Ok(q) => q,
         Err(e) => {
             // An empty result is reported by the mesher itself; there is no table to print.

@@ -101,7 +101,28 @@ pub fn check(mesh: &TetMesh) -> Result<(), QualityError> {
 
 /// Measures `mesh`. Errors: an out-of-range vertex id, a non-finite coordinate, no tets.
 pub fn measure(mesh: &TetMesh) -> Result<MeshQuality, QualityError> {
+    measure_with(mesh, &per_tet(mesh)?)
+}
+
+/// Every tet's measures, in tet order (errors as [`measure`]): for a caller that needs them
+/// too, to measure them once ([`measure_with`]).
+pub fn per_tet(mesh: &TetMesh) -> Result<Vec<TetQuality>, QualityError> {
     check(mesh)?;
+    let p = |v: u32| mesh.vertices[v as usize];
+    Ok(mesh
+        .tets
+        .iter()
+        .map(|t| TetQuality::of(p(t[0]), p(t[1]), p(t[2]), p(t[3])))
+        .collect())
+}
+
+/// [`measure`] from the tets' measures [`per_tet`] took (measured again if they are not as
+/// many as the tets).
+pub fn measure_with(mesh: &TetMesh, per_tet: &[TetQuality]) -> Result<MeshQuality, QualityError> {
+    check(mesh)?;
+    if per_tet.len() != mesh.tets.len() {
+        return measure(mesh);
+    }
     let n = mesh.tets.len();
     let p = |v: u32| mesh.vertices[v as usize];
     let mut used = vec![false; mesh.vertices.len()];
@@ -156,7 +177,7 @@ pub fn measure(mesh: &TetMesh) -> Result<MeshQuality, QualityError> {
         } else if det == 0.0 {
             q.n_zero_volume += 1;
         }
-        let m = TetQuality::of(a, b, c, d);
+        let m = per_tet[i];
         q.volume += m.volume;
         q.shortest_edge = q.shortest_edge.min(m.shortest_edge);
         q.longest_edge = q.longest_edge.max(geom::longest_edge(a, b, c, d));

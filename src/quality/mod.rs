@@ -20,8 +20,8 @@ mod table;
 mod tests;
 
 pub use measure::{
-    check, dihedral_histogram, measure, percentile, MeshQuality, ABOVE_DEG, BELOW_DEG, MIN_BINS,
-    MIN_BIN_DEG,
+    check, dihedral_histogram, measure, measure_with, per_tet, percentile, MeshQuality, ABOVE_DEG,
+    BELOW_DEG, MIN_BINS, MIN_BIN_DEG,
 };
 pub use svg::{svg, SvgSeries};
 pub use table::{compare_histogram_text, compare_table, histogram_text, rows, table};
