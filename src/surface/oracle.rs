@@ -650,10 +650,12 @@ impl Occupancy {
         let mut out = [0usize; 3];
         for k in 0..3 {
             // Truncation is the floor for the non-negative values kept (and a function call
-            // less than `floor` on the baseline x86-64 target); NaN fails the test.
+            // less than `floor` on the baseline x86-64 target); NaN fails the test. Through u32
+            // (saturating like usize, and the clamp below is far under 2^32): the conversion to
+            // usize takes several more instructions.
             let v = f[k] + margin;
             out[k] = if v > 0.0 {
-                (v as usize).min(self.dims[k] - 1)
+                (v as u32 as usize).min(self.dims[k] - 1)
             } else {
                 0
             };
