@@ -125,6 +125,26 @@ pub fn orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
     }
 }
 
+/// Exact sign-valued 2D orientation: > 0 iff (a, b, c) turn counter-clockwise, 0 if collinear.
+///
+/// Shewchuk's adaptive orient2d (its own dynamic filter decides almost every call, and three
+/// points sharing a coordinate give exactly 0 at once) when every coordinate difference is 0
+/// or within the filters' range (then no product underflows or overflows, which its
+/// exactness needs); else the lifted [`orient3d`], which has the same sign.
+#[inline]
+pub fn orient2d(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
+    let safe = |d: f64| d == 0.0 || (FILTER_MIN..=FILTER_MAX).contains(&d.abs());
+    if [a[0] - c[0], b[0] - c[0], a[1] - c[1], b[1] - c[1]]
+        .into_iter()
+        .all(safe)
+    {
+        let p = |q: [f64; 2]| robust::Coord { x: q[0], y: q[1] };
+        return robust::orient2d(p(a), p(b), p(c));
+    }
+    let lift = |q: [f64; 2]| DVec3::new(q[0], q[1], 0.0);
+    orient3d(lift(a), lift(b), lift(c), DVec3::Z)
+}
+
 /// The semi-static filter of [`orient3d`]: `Some(value)` when it decides the sign.
 #[inline(always)]
 fn orient3d_filter(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Option<f64> {
@@ -772,6 +792,53 @@ mod tests {
         let below = DVec3::new(3.1, 7.3, f64::from_bits(0.5f64.to_bits() - 1));
         assert!(orient3d(p[0], p[1], p[2], above) > 0.0);
         assert!(orient3d(p[0], p[1], p[2], below) < 0.0);
+    }
+
+    /// The 2D orientation has the sign of the lifted 3D one on generic, collinear (on a line
+    /// and through shared coordinates), one-ulp-off, tiny and huge configurations.
+    #[test]
+    fn orient2d_signs_match_the_lifted_orient3d() {
+        use rand::{Rng, SeedableRng};
+        let lifted = |a: [f64; 2], b: [f64; 2], c: [f64; 2]| {
+            let l = |q: [f64; 2]| DVec3::new(q[0], q[1], 0.0);
+            sign(orient3d(l(a), l(b), l(c), DVec3::Z))
+        };
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        for k in 0..240_000 {
+            // Inside the filters' range, near its ends, and beyond them (the lifted path).
+            let scale = [1.0, 1e-40, 1e-56, 1e40, 1e56, 1e-200, 1e150, 1e-310][(k / 4) % 8];
+            let mut q = || {
+                [
+                    rng.gen_range(-1.0..1.0) * scale,
+                    rng.gen_range(-1.0..1.0) * scale,
+                ]
+            };
+            let (a, b) = (q(), q());
+            let c = match k % 4 {
+                0 => q(),
+                // On the line ab (up to rounding: either side or on it).
+                1 => {
+                    let t: f64 = rng.gen_range(-2.0..2.0);
+                    [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]
+                }
+                // Sharing a coordinate with a and b: exactly collinear.
+                2 => [a[0], rng.gen_range(-1.0..1.0) * scale],
+                // One ulp off a's x.
+                _ => [f64::from_bits(a[0].to_bits() + 1), a[1]],
+            };
+            let (a, b) = if k % 4 == 2 {
+                ([c[0], a[1]], [c[0], b[1]])
+            } else {
+                (a, b)
+            };
+            assert_eq!(
+                sign(orient2d(a, b, c)),
+                lifted(a, b, c),
+                "{a:?} {b:?} {c:?}"
+            );
+        }
+        assert_eq!(orient2d([0.0, 0.0], [1.0, 0.0], [0.0, 1.0]), 1.0);
+        assert_eq!(orient2d([0.0, 0.0], [0.0, 1.0], [1.0, 0.0]), -1.0);
     }
 
     #[test]

@@ -1,8 +1,7 @@
-//! Exact 2D and 3D incidence tests built on `geom::orient3d` (only `geom` may call `robust`).
+//! Exact 2D and 3D incidence tests built on `geom::orient3d` and `geom::orient2d` (only `geom`
+//! may call `robust`).
 //!
-//! Every decision here is a sign of an exact predicate; no tolerance. 2D orientation is the
-//! 3D orientation of the points lifted to z = 0 against the apex (0, 0, 1), which has exactly
-//! the sign of the 2D determinant.
+//! Every decision here is a sign of an exact predicate; no tolerance.
 
 use crate::geom::orient3d;
 use glam::DVec3;
@@ -13,9 +12,7 @@ pub type P2 = [f64; 2];
 
 /// Sign of the 2D orientation: > 0 iff (a, b, c) turn counter-clockwise.
 pub fn orient2d(a: P2, b: P2, c: P2) -> Ordering {
-    // det[b-a, c-a, apex-a] with a, b, c at z = 0 and apex (0,0,1) equals the 2D determinant.
-    let lift = |p: P2| DVec3::new(p[0], p[1], 0.0);
-    sign(orient3d(lift(a), lift(b), lift(c), DVec3::Z))
+    sign(crate::geom::orient2d(a, b, c))
 }
 
 /// Sign of `orient3d` as an ordering.
