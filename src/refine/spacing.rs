@@ -19,12 +19,12 @@ pub struct AutoSpacing {
     dims: [usize; 3],
     /// f at each cell centre (up to the chamfer propagation's approximation).
     value: Vec<f64>,
-    /// Per cell: boundary vertices whose h is small next to the cell size, (point, h), so that
-    /// f near them is exact instead of smeared over whole cells (a cluster of tiny edges at an
-    /// acute corner must not make a whole cell fine).
-    small: Vec<Vec<(DVec3, f64)>>,
-    /// Per cell: some cell among it and its 26 neighbours holds small sizes.
-    small_nearby: Vec<bool>,
+    /// Boundary vertices whose h is small next to the cell size, (point, h), so that f near
+    /// them is exact instead of smeared over whole cells (a cluster of tiny edges at an acute
+    /// corner must not make a whole cell fine): for cell i, those of it and its 26 neighbours
+    /// are `nearby[nearby_start[i]..nearby_start[i + 1]]`, side by side for `at`.
+    nearby: Vec<(DVec3, f64)>,
+    nearby_start: Vec<u32>,
 }
 
 impl AutoSpacing {
@@ -70,21 +70,22 @@ impl AutoSpacing {
             cell,
             dims,
             value: vec![ext / 4.0; n],
-            small: vec![vec![]; n],
-            small_nearby: vec![false; n],
+            nearby: vec![],
+            nearby_start: vec![],
         };
+        let mut small: Vec<Vec<(DVec3, f64)>> = vec![vec![]; n];
         for &(p, hv) in sized {
             let i = s.index(p);
             let at_centre = hv + ALPHA * p.distance(s.centre(i));
             s.value[i] = s.value[i].min(at_centre);
             if hv < SMALL_CELLS * ALPHA * cell {
-                s.small[i].push((p, hv));
+                small[i].push((p, hv));
             }
         }
-        for list in &mut s.small {
+        for list in &mut small {
             prune_dominated(list);
         }
-        s.mark_small_nearby();
+        s.gather_nearby(&small);
         s.propagate();
         s
     }
@@ -103,26 +104,26 @@ impl AutoSpacing {
         (k * self.dims[1] + j) * self.dims[0] + i
     }
 
-    /// Flags every cell that has small sizes in it or in one of its 26 neighbours (`at` looks
-    /// at those lists only there).
-    fn mark_small_nearby(&mut self) {
+    /// Fills `nearby`: per cell, the small sizes of it and its 26 neighbours (cells in z, y, x
+    /// order), so that `at` reads one slice.
+    fn gather_nearby(&mut self, small: &[Vec<(DVec3, f64)>]) {
         let [nx, ny, nz] = self.dims;
-        for k in 0..nz {
-            for j in 0..ny {
-                for i in 0..nx {
-                    if self.small[(k * ny + j) * nx + i].is_empty() {
-                        continue;
-                    }
-                    for c in k.saturating_sub(1)..(k + 2).min(nz) {
-                        for b in j.saturating_sub(1)..(j + 2).min(ny) {
-                            for a in i.saturating_sub(1)..(i + 2).min(nx) {
-                                self.small_nearby[(c * ny + b) * nx + a] = true;
+        self.nearby_start = Vec::with_capacity(small.len() + 1);
+        for kk in 0..nz {
+            for jj in 0..ny {
+                for ii in 0..nx {
+                    self.nearby_start.push(self.nearby.len() as u32);
+                    for k in kk.saturating_sub(1)..(kk + 2).min(nz) {
+                        for j in jj.saturating_sub(1)..(jj + 2).min(ny) {
+                            for c in ii.saturating_sub(1)..(ii + 2).min(nx) {
+                                self.nearby.extend_from_slice(&small[(k * ny + j) * nx + c]);
                             }
                         }
                     }
                 }
             }
         }
+        self.nearby_start.push(self.nearby.len() as u32);
     }
 
     /// Two chamfer sweeps (forward, backward) over the 26-neighbourhood enforce
@@ -216,22 +217,11 @@ impl Spacing for AutoSpacing {
         // ones exactly from the cell and its 26 neighbours: a small size further away than a
         // cell is already within its grading in the centre values.
         let i = self.index(p);
-        let mut f = self.value[i] + ALPHA * p.distance(self.centre(i));
-        if !self.small_nearby[i] {
-            return f;
-        }
-        let [nx, ny, nz] = self.dims;
-        let (ii, jj, kk) = (i % nx, (i / nx) % ny, i / (nx * ny));
-        for k in kk.saturating_sub(1)..(kk + 2).min(nz) {
-            for j in jj.saturating_sub(1)..(jj + 2).min(ny) {
-                for c in ii.saturating_sub(1)..(ii + 2).min(nx) {
-                    for &(q, hq) in &self.small[(k * ny + j) * nx + c] {
-                        f = f.min(hq + ALPHA * q.distance(p));
-                    }
-                }
-            }
-        }
-        f
+        let f = self.value[i] + ALPHA * p.distance(self.centre(i));
+        let range = self.nearby_start[i] as usize..self.nearby_start[i + 1] as usize;
+        self.nearby[range]
+            .iter()
+            .fold(f, |f, &(q, hq)| f.min(hq + ALPHA * q.distance(p)))
     }
 }
 
