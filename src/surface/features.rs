@@ -67,24 +67,61 @@ pub struct CornerAngle {
     pub angle: f64,
 }
 
-/// Triangles using an edge, each with whether it runs the edge from the smaller id up.
-type EdgeUses = FxHashMap<[u32; 2], Vec<(u32, bool)>>;
+/// One use of an edge by a triangle: the edge (sorted ids), the triangle, and whether it
+/// runs the edge from the smaller id up.
+type EdgeUse = ([u32; 2], u32, bool);
 
 fn sorted(a: u32, b: u32) -> [u32; 2] {
     [a.min(b), a.max(b)]
 }
 
-fn edge_uses(s: &InputSurface) -> EdgeUses {
-    let mut uses: EdgeUses = FxHashMap::default();
-    for (t, tri) in s.triangles.iter().enumerate() {
-        for j in 0..3 {
-            let (a, b) = (tri[j], tri[(j + 1) % 3]);
-            uses.entry(sorted(a, b))
-                .or_default()
-                .push((t as u32, a < b));
+/// Every edge's uses, side by side: `uses` sorted by edge (triangles in order within an
+/// edge), and for each triangle side (3 t + j, side j from corner j) the range of its edge.
+struct EdgeUses {
+    uses: Vec<EdgeUse>,
+    range_of_side: Vec<(u32, u32)>,
+}
+
+impl EdgeUses {
+    fn of(s: &InputSurface) -> EdgeUses {
+        let mut keyed = Vec::with_capacity(3 * s.triangles.len());
+        for (t, tri) in s.triangles.iter().enumerate() {
+            for j in 0..3 {
+                let (a, b) = (tri[j], tri[(j + 1) % 3]);
+                let e = sorted(a, b);
+                keyed.push((
+                    (u64::from(e[0]) << 32) | u64::from(e[1]),
+                    (3 * t + j) as u32,
+                    a < b,
+                ));
+            }
+        }
+        keyed.sort_unstable();
+        let mut range_of_side = vec![(0, 0); keyed.len()];
+        let mut uses = Vec::with_capacity(keyed.len());
+        for run in keyed.chunk_by(|x, y| x.0 == y.0) {
+            let range = (uses.len() as u32, (uses.len() + run.len()) as u32);
+            for &(key, side, up) in run {
+                range_of_side[side as usize] = range;
+                uses.push(([(key >> 32) as u32, key as u32], side / 3, up));
+            }
+        }
+        EdgeUses {
+            uses,
+            range_of_side,
         }
     }
-    uses
+
+    /// The runs of uses of one edge, edges ascending.
+    fn runs(&self) -> impl Iterator<Item = &[EdgeUse]> {
+        self.uses.chunk_by(|a, b| a.0 == b.0)
+    }
+
+    /// The uses of the edge of side j of triangle t.
+    fn of_side(&self, t: u32, j: usize) -> &[EdgeUse] {
+        let (a, b) = self.range_of_side[3 * t as usize + j];
+        &self.uses[a as usize..b as usize]
+    }
 }
 
 fn angle_deg(u: DVec3, v: DVec3) -> f64 {
@@ -94,7 +131,7 @@ fn angle_deg(u: DVec3, v: DVec3) -> f64 {
 
 /// Normal deviation across a two-triangle edge, with the normals oriented consistently (a
 /// consistently oriented pair runs the edge in opposite directions).
-fn normal_deviation(s: &InputSurface, (t1, up1): (u32, bool), (t2, up2): (u32, bool)) -> f64 {
+fn normal_deviation(s: &InputSurface, (_, t1, up1): EdgeUse, (_, t2, up2): EdgeUse) -> f64 {
     let n1 = s.normal(t1 as usize);
     let mut n2 = s.normal(t2 as usize);
     if up1 == up2 {
@@ -106,12 +143,12 @@ fn normal_deviation(s: &InputSurface, (t1, up1): (u32, bool), (t2, up2): (u32, b
     angle_deg(n1, n2)
 }
 
-fn is_feature(s: &InputSurface, p: &FeatureParams, uses: &[(u32, bool)]) -> bool {
+fn is_feature(s: &InputSurface, p: &FeatureParams, uses: &[EdgeUse]) -> bool {
     let [u1, u2] = match uses {
         [u1, u2] => [*u1, *u2],
         _ => return true,
     };
-    let (t1, t2) = (u1.0 as usize, u2.0 as usize);
+    let (t1, t2) = (u1.1 as usize, u2.1 as usize);
     if s.facet_of[t1] == s.facet_of[t2] {
         return false;
     }
@@ -124,13 +161,11 @@ fn is_feature(s: &InputSurface, p: &FeatureParams, uses: &[(u32, bool)]) -> bool
 impl Features {
     /// Detects the features of `s`.
     pub fn detect(s: &InputSurface, p: &FeatureParams) -> Features {
-        let uses = edge_uses(s);
-        let mut keys: Vec<[u32; 2]> = uses.keys().copied().collect();
-        keys.sort_unstable();
-        let edges: Vec<[u32; 2]> = keys
-            .iter()
-            .copied()
-            .filter(|e| is_feature(s, p, &uses[e]))
+        let uses = EdgeUses::of(s);
+        let edges: Vec<[u32; 2]> = uses
+            .runs()
+            .filter(|run| is_feature(s, p, run))
+            .map(|run| run[0].0)
             .collect();
         let graph = FeatureGraph::new(s.vertices.len(), &edges);
         let corners = graph.corners(s, p.feature_angle);
@@ -318,7 +353,7 @@ fn patches(s: &InputSurface, uses: &EdgeUses, feature_edges: &[[u32; 2]]) -> (Ve
                 if feature_edges.binary_search(&e).is_ok() {
                     continue;
                 }
-                for &(u, _) in &uses[&e] {
+                for &(_, u, _) in uses.of_side(t, j) {
                     if patch_of[u as usize] == u32::MAX {
                         patch_of[u as usize] = n_patches;
                         stack.push(u);
