@@ -594,18 +594,18 @@ impl<'a> SurfaceMesher<'a> {
     }
 
     /// Face `i` of tet `t` if its Voronoi edge crosses the surface, with the crossing farthest
-    /// from its vertices as surface centre.
+    /// from its vertices as surface centre: the tracking's record of it (the Voronoi edge was
+    /// crossed when the face appeared; crossing it again from the other end could move the
+    /// centre by a rounding error).
     fn facet_at(&self, t: u32, i: usize) -> Option<Restricted> {
-        let tv = self.dt.tet(t);
-        let n = self.dt.neighbors(t)[i];
-        let nv = self.dt.tet(n);
-        if tv.contains(&INFINITE) || nv.contains(&INFINITE) {
-            return None;
-        }
-        let c1 = self.centre_of(t)?;
-        let c2 = self.centre_of(n)?;
-        let face = FACE[i].map(|k| tv[k]);
-        Self::facet_from(&self.dt, face, self.oracle.crossings(c1, c2))
+        let face = FACE[i].map(|k| self.dt.tet(t)[k]);
+        let &(centre, radius, triangle) = self.track.restricted.get(&key3(face))?;
+        Some(Restricted {
+            vertices: face,
+            centre,
+            radius,
+            triangle,
+        })
     }
 
     /// Face `face` as a restricted facet, given where its Voronoi edge crosses the surface:

@@ -77,8 +77,16 @@ pub(crate) fn build_cells(
             vertices[*tv.iter().find(|&&x| x != u && x != v).unwrap() as usize]
         };
         let (pu, pv) = (vertices[u as usize], vertices[v as usize]);
-        let thirds: Vec<DVec3> = users.iter().map(|&t| third(t)).collect();
-        let order = radial_order(pu, pv, &thirds);
+        // One or two triangles have only one order (the edges of a manifold surface: all but
+        // a few), and no list to allocate.
+        let sorted_order;
+        let order: &[usize] = if users.len() <= 2 {
+            &[0, 1][..users.len()]
+        } else {
+            let thirds: Vec<DVec3> = users.iter().map(|&t| third(t)).collect();
+            sorted_order = radial_order(pu, pv, &thirds);
+            &sorted_order
+        };
         let k = order.len();
         for i in 0..k {
             let (a, b) = (users[order[i]], users[order[(i + 1) % k]]);

@@ -106,11 +106,6 @@ impl SurfaceMesher<'_> {
         self.track.tets.get(t as usize).is_some_and(|i| i.inside)
     }
 
-    /// The circumcentre of tet `t` (None when flat or infinite).
-    pub(super) fn centre_of(&self, t: u32) -> Option<DVec3> {
-        self.sphere_of(t).map(|(centre, _)| centre)
-    }
-
     /// The circumcentre and circumradius of live tet `t` (None when flat or infinite), as
     /// `geom::circumsphere` gives them.
     pub(super) fn sphere_of(&self, t: u32) -> Option<(DVec3, f64)> {
