@@ -104,15 +104,22 @@ impl SurfaceOracle {
 
     /// An oracle for distance queries ([`Self::closest`], [`Self::distance_beyond_hinted`]):
     /// without the occupancy grid, which only answers segment queries early (they still work,
-    /// through the tree) and costs as much to build as the tree on a coarse surface.
+    /// through the tree) and costs as much to build as the tree on a coarse surface, and with
+    /// whole triangles in the leaves (pieces tighten the boxes a segment passes; a distance
+    /// query prunes well enough by whole triangles, and the tree is cheaper to build).
     pub fn for_distances(surface: &InputSurface) -> SurfaceOracle {
         Self::build(surface, false)
     }
 
-    fn build(surface: &InputSurface, with_grid: bool) -> SurfaceOracle {
+    fn build(surface: &InputSurface, for_segments: bool) -> SurfaceOracle {
         let n = surface.triangles.len();
         let diagonal = surface.bbox_diagonal();
-        let pieces = cut_into_pieces(surface, PIECE_FRACTION * diagonal);
+        let piece = if for_segments {
+            PIECE_FRACTION * diagonal
+        } else {
+            f64::INFINITY
+        };
+        let pieces = cut_into_pieces(surface, piece);
         let corners: Vec<[DVec3; 3]> = (0..n).map(|t| surface.corners(t)).collect();
         let mut o = SurfaceOracle {
             nodes: Vec::with_capacity(2 * pieces.len() / LEAF_SIZE + 1),
@@ -120,7 +127,7 @@ impl SurfaceOracle {
             leaf_tri: vec![],
             leaf_box: vec![],
             neighbours: edge_neighbours(&surface.triangles),
-            grid: if with_grid {
+            grid: if for_segments {
                 Occupancy::new(&pieces, &corners, GRID_FRACTION * diagonal)
             } else {
                 Occupancy::empty()
