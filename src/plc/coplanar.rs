@@ -31,7 +31,7 @@ use rustc_hash::FxHashMap;
 /// all facet markers 1, 2, ... in facet order.
 pub fn merge_coplanar_facets(plc: &mut PlcInput) {
     let verts = &plc.vertices;
-    let facets = std::mem::take(&mut plc.facets);
+    let mut facets = std::mem::take(&mut plc.facets);
     let planes: Vec<Option<Plane>> = facets.iter().map(|f| Plane::of(f, verts)).collect();
 
     // (undirected edge, facet, forward) of every polygon side, sorted: the two uses of an
@@ -94,7 +94,8 @@ pub fn merge_coplanar_facets(plc: &mut PlcInput) {
                 continue;
             }
         }
-        out.extend(g.iter().map(|&fi| facets[fi].clone()));
+        // Each facet is in one group: moved, not copied.
+        out.extend(g.iter().map(|&fi| std::mem::take(&mut facets[fi])));
     }
     for (i, f) in out.iter_mut().enumerate() {
         f.marker = i32::try_from(i + 1).unwrap_or(i32::MAX);
