@@ -18,7 +18,7 @@
 
 use super::text::{
     check_mesh, check_mesh_io, create, err_at, err_file, float_text, parse_f64, read_text, to_u32,
-    with_path, write_err, write_float_line, write_int_line,
+    with_path, write_err, write_float_line, write_int_line, write_line,
 };
 use super::{CellField, IoError};
 use crate::mesh::TetMesh;
@@ -56,23 +56,15 @@ fn xml_escape(s: &str) -> String {
 }
 
 /// Writes items `per_line` to a line, each appended to the line by `text`.
-fn write_rows<W: Write, T>(
+fn write_rows<W: Write, T: Copy>(
     w: &mut W,
     items: &[T],
     per_line: usize,
-    mut text: impl FnMut(&mut Vec<u8>, &T),
+    mut text: impl FnMut(&mut Vec<u8>, T),
 ) -> std::io::Result<()> {
     let mut line = Vec::new();
     for chunk in items.chunks(per_line) {
-        line.clear();
-        for (i, x) in chunk.iter().enumerate() {
-            if i > 0 {
-                line.push(b' ');
-            }
-            text(&mut line, x);
-        }
-        line.push(b'\n');
-        w.write_all(&line)?;
+        write_line(w, &mut line, chunk, &mut text)?;
     }
     Ok(())
 }
@@ -126,21 +118,21 @@ pub fn format_vtu<W: Write>(
         "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">"
     )?;
     let offsets: Vec<usize> = (1..=nt).map(|i| 4 * i).collect();
-    write_rows(w, &offsets, 16, |line, &o| push_int(line, o))?;
+    write_rows(w, &offsets, 16, push_int)?;
     writeln!(w, "</DataArray>")?;
     writeln!(
         w,
         "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">"
     )?;
     let types = vec![10u8; nt];
-    write_rows(w, &types, 32, |line, &t| push_int(line, t))?;
+    write_rows(w, &types, 32, push_int)?;
     writeln!(w, "</DataArray>\n</Cells>")?;
     writeln!(w, "<CellData Scalars=\"region\">")?;
     writeln!(
         w,
         "<DataArray type=\"Int32\" Name=\"region\" format=\"ascii\">"
     )?;
-    write_rows(w, &mesh.tet_regions, 16, |line, &r| push_int(line, r))?;
+    write_rows(w, &mesh.tet_regions, 16, push_int)?;
     writeln!(w, "</DataArray>")?;
     for f in cell_fields {
         writeln!(
@@ -149,7 +141,7 @@ pub fn format_vtu<W: Write>(
             xml_escape(f.name)
         )?;
         let mut buf = zmij::Buffer::new();
-        write_rows(w, f.values, 8, |line, &x| {
+        write_rows(w, f.values, 8, |line, x| {
             line.extend_from_slice(float_text(x, &mut buf).as_bytes())
         })?;
         writeln!(w, "</DataArray>")?;
