@@ -10,6 +10,13 @@
 
 mod cli;
 
+// The refinement makes hundreds of thousands of small, short-lived allocations (cavities, crossing
+// lists, queues): mimalloc serves them in fewer instructions than glibc's malloc (fandisk: 2,002M
+// -> 1,947M instructions, same output). Only the command line: the library uses its caller's
+// allocator.
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 use clap::{Parser, Subcommand};
 use cli::gen::{self, Kind};
 use cli::tri;
