@@ -105,25 +105,42 @@ impl AutoSpacing {
     }
 
     /// Fills `nearby`: per cell, the small sizes of it and its 26 neighbours (cells in z, y, x
-    /// order), so that `at` reads one slice.
+    /// order), so that `at` reads one slice. Scattered from the few cells that hold small sizes
+    /// (visited in index order, so each list keeps the z, y, x order of its cells).
     fn gather_nearby(&mut self, small: &[Vec<(DVec3, f64)>]) {
-        let [nx, ny, nz] = self.dims;
-        self.nearby_start = Vec::with_capacity(small.len() + 1);
-        for kk in 0..nz {
-            for jj in 0..ny {
-                for ii in 0..nx {
-                    self.nearby_start.push(self.nearby.len() as u32);
-                    for k in kk.saturating_sub(1)..(kk + 2).min(nz) {
-                        for j in jj.saturating_sub(1)..(jj + 2).min(ny) {
-                            for c in ii.saturating_sub(1)..(ii + 2).min(nx) {
-                                self.nearby.extend_from_slice(&small[(k * ny + j) * nx + c]);
-                            }
-                        }
-                    }
-                }
+        let holding: Vec<usize> = (0..small.len()).filter(|&i| !small[i].is_empty()).collect();
+        let mut start = vec![0u32; small.len() + 1];
+        for &i in &holding {
+            let n = small[i].len() as u32;
+            for c in self.neighbourhood(i) {
+                start[c + 1] += n;
             }
         }
-        self.nearby_start.push(self.nearby.len() as u32);
+        for c in 0..small.len() {
+            start[c + 1] += start[c];
+        }
+        let mut next: Vec<u32> = start[..small.len()].to_vec();
+        let mut nearby = vec![(DVec3::ZERO, 0.0); start[small.len()] as usize];
+        for &i in &holding {
+            for c in self.neighbourhood(i) {
+                let at = next[c] as usize;
+                nearby[at..at + small[i].len()].copy_from_slice(&small[i]);
+                next[c] += small[i].len() as u32;
+            }
+        }
+        self.nearby = nearby;
+        self.nearby_start = start;
+    }
+
+    /// Cell i and its neighbours (26 inside the grid), in index order.
+    fn neighbourhood(&self, i: usize) -> impl Iterator<Item = usize> {
+        let [nx, ny, nz] = self.dims;
+        let (ii, jj, kk) = (i % nx, (i / nx) % ny, i / (nx * ny));
+        (kk.saturating_sub(1)..(kk + 2).min(nz)).flat_map(move |k| {
+            (jj.saturating_sub(1)..(jj + 2).min(ny)).flat_map(move |j| {
+                (ii.saturating_sub(1)..(ii + 2).min(nx)).map(move |c| (k * ny + j) * nx + c)
+            })
+        })
     }
 
     /// Two chamfer sweeps (forward, backward) over the 26-neighbourhood enforce
