@@ -90,9 +90,14 @@ impl AutoSpacing {
         s
     }
 
-    fn centre(&self, i: usize) -> DVec3 {
+    /// The (x, y, z) grid coordinates of cell i.
+    fn coords(&self, i: usize) -> (usize, usize, usize) {
         let [nx, ny, _] = self.dims;
-        let (ii, jj, kk) = (i % nx, (i / nx) % ny, i / (nx * ny));
+        (i % nx, (i / nx) % ny, i / (nx * ny))
+    }
+
+    fn centre(&self, i: usize) -> DVec3 {
+        let (ii, jj, kk) = self.coords(i);
         self.lo + DVec3::new(ii as f64 + 0.5, jj as f64 + 0.5, kk as f64 + 0.5) * self.cell
     }
 
@@ -135,7 +140,7 @@ impl AutoSpacing {
     /// Cell i and its neighbours (26 inside the grid), in index order.
     fn neighbourhood(&self, i: usize) -> impl Iterator<Item = usize> {
         let [nx, ny, nz] = self.dims;
-        let (ii, jj, kk) = (i % nx, (i / nx) % ny, i / (nx * ny));
+        let (ii, jj, kk) = self.coords(i);
         (kk.saturating_sub(1)..(kk + 2).min(nz)).flat_map(move |k| {
             (jj.saturating_sub(1)..(jj + 2).min(ny)).flat_map(move |j| {
                 (ii.saturating_sub(1)..(ii + 2).min(nx)).map(move |c| (k * ny + j) * nx + c)
