@@ -24,6 +24,8 @@ pub(super) struct Scratch {
     pub(super) created: Vec<u32>,
     /// Vertices of the tets the last insertion deleted.
     pub(super) removed: Vec<[u32; 4]>,
+    /// The ids those tets had, in the same order (the created tets reuse some of them).
+    pub(super) removed_ids: Vec<u32>,
     /// Tags of the boundary faces' owners (when tags are enabled).
     tags: Vec<u32>,
     /// Directed boundary edge -> face reference of the new tet that owns it.
@@ -41,6 +43,7 @@ impl Scratch {
             + self.boundary.capacity() * std::mem::size_of::<BoundaryFace>()
             + self.created.capacity() * 4
             + self.removed.capacity() * 16
+            + self.removed_ids.capacity() * 4
             + self.tags.capacity() * 4
             + self.edges.memory_bytes()
     }
@@ -450,6 +453,7 @@ impl Delaunay {
         for &t in &s.cavity {
             s.removed.push(self.tet_ref(t).v);
         }
+        s.removed_ids.clone_from(&s.cavity);
         let removed_ghosts = s
             .cavity
             .iter()

@@ -300,6 +300,13 @@ impl Delaunay {
         &self.scratch.removed
     }
 
+    /// The ids the tets of [`Self::last_removed`] had, in the same order: the created tets
+    /// reuse some of them, so what a caller stored per id for the deleted tets is to be read
+    /// before it stores anything for the created ones.
+    pub fn last_removed_ids(&self) -> &[u32] {
+        &self.scratch.removed_ids
+    }
+
     /// A finite tet whose closure contains `p`, or a hull tet with `p` beyond its hull face.
     pub fn locate_point(&mut self, p: DVec3, hint: Option<u32>) -> u32 {
         let hint = hint.filter(|&t| self.is_alive(t)).unwrap_or(self.last);

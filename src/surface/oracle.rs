@@ -313,6 +313,23 @@ impl SurfaceOracle {
                 }
             }
         }
+        if let Some(t) = self.triangle_within(p, r) {
+            *hint = Some(t);
+            return None;
+        }
+        let closest = self.closest(p)?;
+        *hint = Some(closest.triangle);
+        Some(closest.distance)
+    }
+
+    /// Whether no triangle comes within `r` of `p`.
+    pub fn clear_within(&self, p: DVec3, r: f64) -> bool {
+        self.triangle_within(p, r).is_none()
+    }
+
+    /// A triangle within `r` of `p`, found through the tree (the first one met).
+    fn triangle_within(&self, p: DVec3, r: f64) -> Option<u32> {
+        let within = |t: u32| self.within(t, p, r);
         let mut stack = [0usize; 128];
         let mut top = usize::from(!self.nodes.is_empty());
         while top > 0 {
@@ -331,8 +348,7 @@ impl SurfaceOracle {
                     // its triangle nearest to p, if that is within r: the piece that does is
                     // visited too. The box test is much cheaper than the closest point.
                     if aabb_distance(b, p) <= r && within(t) {
-                        *hint = Some(t);
-                        return None;
+                        return Some(t);
                     }
                 }
             } else {
@@ -343,9 +359,7 @@ impl SurfaceOracle {
                 top += 2;
             }
         }
-        let closest = self.closest(p)?;
-        *hint = Some(closest.triangle);
-        Some(closest.distance)
+        None
     }
 
     /// From triangle `t`, steps across an edge `p` lies beyond while the triangle reached is not

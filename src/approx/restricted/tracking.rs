@@ -16,6 +16,9 @@ use crate::surface::oracle::Side;
 use glam::DVec3;
 use rustc_hash::FxHashMap;
 
+/// Relative margin of [`SurfaceMesher::surface_untouched`]'s distance test.
+const UNTOUCHED_MARGIN: f64 = 1e-6;
+
 #[derive(Default)]
 pub(super) struct Tracking {
     /// Per tet id.
@@ -126,9 +129,33 @@ impl SurfaceMesher<'_> {
 
     /// After inserting `new_vertex`: the restricted facets of the removed tets go; the created
     /// tets get their circumcentre and side, their faces are checked (each Voronoi edge crossed
-    /// once) and the bad restricted facets queued.
+    /// once) and the bad restricted facets queued. A cell-level point whose Voronoi cell misses
+    /// the surface changes none of that but the sides (`surface_untouched`).
     pub(super) fn track_insertion(&mut self, new_vertex: u32, created: &[u32]) {
         let mut track = std::mem::take(&mut self.track);
+        let cap = self.dt.tet_capacity();
+        if track.tets.len() < cap {
+            track.tets.resize(cap, TetInfo::default());
+        }
+        // Read before the created tets take over the removed ones' slots.
+        let removed_side = self
+            .dt
+            .last_removed_ids()
+            .iter()
+            .map(|&t| track.tets[t as usize])
+            .find_map(|info| info.centre().map(|_| info.inside));
+        for &t in created {
+            track.tets[t as usize] = TetInfo::of(&self.dt, self.dt.tet(t));
+        }
+        if let Some(inside) =
+            removed_side.filter(|_| self.surface_untouched(new_vertex, created, &track.tets))
+        {
+            for &t in created {
+                track.tets[t as usize].inside = inside;
+            }
+            self.track = track;
+            return;
+        }
         // A facet found again with the same surface centre, ball and input triangle was judged
         // already (its criteria depend on nothing else): it is not judged again.
         let mut before = vec![];
@@ -139,13 +166,6 @@ impl SurfaceMesher<'_> {
                     before.push((key, old));
                 }
             }
-        }
-        let cap = self.dt.tet_capacity();
-        if track.tets.len() < cap {
-            track.tets.resize(cap, TetInfo::default());
-        }
-        for &t in created {
-            track.tets[t as usize] = TetInfo::of(&self.dt, self.dt.tet(t));
         }
         let mut found = vec![];
         for &t in created {
@@ -182,6 +202,43 @@ impl SurfaceMesher<'_> {
         for r in found {
             self.queue_if_bad(r);
         }
+    }
+
+    /// Whether cell-level vertex `v`'s Voronoi cell certainly misses the surface. The cell is
+    /// the hull of the created tets' circumcentres (all finite): it lies in any ball holding
+    /// them, here the one about the middle of their bounding box. If that ball misses the
+    /// surface:
+    /// - every new face at `v` has its Voronoi edge in the cell: none is restricted;
+    /// - every cavity boundary face keeps the part of its old Voronoi edge outside the cell,
+    ///   so the same crossings: the same record, judged already;
+    /// - the removed tets' inner faces had their Voronoi edges in the cell: none was
+    ///   restricted;
+    /// - the cell is on one side of the surface, so all created circumcentres are on the side
+    ///   of the removed ones (which lie in it too: `v` is nearer to them than any other site).
+    fn surface_untouched(&self, v: u32, created: &[u32], tets: &[TetInfo]) -> bool {
+        if !matches!(self.loc.get(v as usize), Some(super::Loc::Volume)) {
+            return false;
+        }
+        let mut centres = Vec::with_capacity(created.len());
+        for &t in created {
+            match tets[t as usize].centre() {
+                Some(c) => centres.push(c),
+                None => return false, // a flat or infinite new tet: the cell is not that hull
+            }
+        }
+        let (lo, hi) = centres
+            .iter()
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &c| {
+                (lo.min(c), hi.max(c))
+            });
+        let middle = (lo + hi) / 2.0;
+        let radius = centres
+            .iter()
+            .map(|&c| (c - middle).length())
+            .fold(0.0, f64::max);
+        // The distances are floating point: a relative margin far above their rounding.
+        self.oracle
+            .clear_within(middle, radius * (1.0 + UNTOUCHED_MARGIN))
     }
 
     /// [`Classified`]: a walk from tet to neighbouring tet, where the segment between their
