@@ -16,6 +16,13 @@ use crate::surface::oracle::Side;
 use glam::DVec3;
 use rustc_hash::FxHashMap;
 
+/// Whether `face` was a restricted facet before the insertion (`before`: the records the
+/// removed tets' faces had).
+fn was_restricted(before: &[([u32; 3], (DVec3, f64, u32))], face: [u32; 3]) -> bool {
+    let key = key3(face);
+    before.iter().any(|(k, _)| *k == key)
+}
+
 /// Relative margin of [`SurfaceMesher::surface_untouched`]'s distance test.
 const UNTOUCHED_MARGIN: f64 = 1e-6;
 
@@ -138,12 +145,17 @@ impl SurfaceMesher<'_> {
             track.tets.resize(cap, TetInfo::default());
         }
         // Read before the created tets take over the removed ones' slots.
-        let removed_side = self
+        let removed: Vec<TetInfo> = self
             .dt
             .last_removed_ids()
             .iter()
             .map(|&t| track.tets[t as usize])
+            .collect();
+        let removed_side = removed
+            .iter()
             .find_map(|info| info.centre().map(|_| info.inside));
+        // Then every cavity boundary face had a Voronoi edge, crossed when it last changed.
+        let removed_centred = removed.iter().all(|info| info.centre().is_some());
         for &t in created {
             track.tets[t as usize] = TetInfo::of(&self.dt, self.dt.tet(t));
         }
@@ -180,6 +192,14 @@ impl SurfaceMesher<'_> {
                 }
                 // Infinite tets have no centre: the neighbour's record alone says it.
                 let other = track.tets[n as usize];
+                let face = FACE[i].map(|k| tv[k]);
+                let both_centred = c.is_some() && other.centre().is_some();
+                if outer && both_centred && removed_centred && !was_restricted(&before, face) {
+                    // The new Voronoi edge is the part of the old one outside the new vertex's
+                    // cell: the old one crossed nothing, so neither does it (even parity).
+                    track.tets[t as usize].inside = other.inside;
+                    continue;
+                }
                 let (crossings, parity) = match (c, other.centre()) {
                     (Some(c), Some(cn)) => self.oracle.crossings_and_parity(c, cn),
                     _ => (vec![], None),
@@ -187,7 +207,6 @@ impl SurfaceMesher<'_> {
                 if outer {
                     track.tets[t as usize].inside = self.side_across(other.inside, c, parity);
                 }
-                let face = FACE[i].map(|k| tv[k]);
                 if let Some(r) = Self::facet_from(&self.dt, face, crossings) {
                     let key = key3(r.vertices);
                     let ball = (r.centre, r.radius, r.triangle);
