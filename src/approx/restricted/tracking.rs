@@ -16,9 +16,13 @@ use crate::surface::oracle::Side;
 use glam::DVec3;
 use rustc_hash::FxHashMap;
 
+/// A restricted facet's surface centre, surface-ball radius and the input triangle the centre
+/// lies on.
+pub(super) type SurfaceBall = (DVec3, f64, u32);
+
 /// Whether `face` was a restricted facet before the insertion (`before`: the records the
 /// removed tets' faces had).
-fn was_restricted(before: &[([u32; 3], (DVec3, f64, u32))], face: [u32; 3]) -> bool {
+fn was_restricted(before: &[([u32; 3], SurfaceBall)], face: [u32; 3]) -> bool {
     let key = key3(face);
     before.iter().any(|(k, _)| *k == key)
 }
@@ -30,9 +34,8 @@ const UNTOUCHED_MARGIN: f64 = 1e-6;
 pub(super) struct Tracking {
     /// Per tet id.
     pub tets: Vec<TetInfo>,
-    /// The restricted facets (sorted vertices): surface centre, surface-ball radius and the
-    /// input triangle the centre lies on.
-    pub restricted: FxHashMap<[u32; 3], (DVec3, f64, u32)>,
+    /// The restricted facets (sorted vertices) and their surface balls.
+    pub restricted: FxHashMap<[u32; 3], SurfaceBall>,
 }
 
 /// What is tracked of one tet, side by side: each insertion reads it for the tets around its
