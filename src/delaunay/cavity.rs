@@ -109,6 +109,33 @@ impl Cavity {
     }
 }
 
+/// Sees a cavity's boundary faces while the search finds them, and may stop it (a refinement
+/// point's small slivers are counted so, and a hopeless candidate is left half-searched).
+pub trait CavityWatch {
+    /// Whether the search shows this watch anything (false: the calls compile away).
+    const WATCHES: bool = true;
+
+    /// Boundary faces found since the last call, with the triangulation's points (a face with
+    /// `INFINITE` makes a hull tet); false stops the search.
+    fn faces(&mut self, faces: &[BoundaryFace], points: &[DVec3]) -> bool;
+}
+
+/// Boundary faces go to a [`CavityWatch`] in multiples of this many while the search runs
+/// (the sliver screen's batch).
+pub const WATCH_BATCH: usize = 8;
+
+/// The watch of a plain search.
+struct NoWatch;
+
+impl CavityWatch for NoWatch {
+    const WATCHES: bool = false;
+
+    #[inline(always)]
+    fn faces(&mut self, _: &[BoundaryFace], _: &[DVec3]) -> bool {
+        true
+    }
+}
+
 /// Cavity search marks (zero: not visited).
 const INSIDE: u8 = 1;
 const OUTSIDE: u8 = 2;
@@ -136,7 +163,7 @@ impl Delaunay {
         if let Some(dup) = self.coincident_vertex(start, p) {
             return Inserted::Duplicate(dup);
         }
-        self.find_cavity(p, rank, start);
+        self.find_cavity(p, rank, start, &mut NoWatch);
         self.fill_cavity(id);
         self.n_vertices += 1;
         Inserted::New(id)
@@ -163,14 +190,48 @@ impl Delaunay {
     /// (any alive tet). The cavity goes into the triangulation's one set of buffers, so a
     /// probe makes every earlier token stale unless it is of the same point.
     pub fn probe(&mut self, p: DVec3, hint: Option<u32>) -> Probe {
+        match self.start_probe(p, hint) {
+            Err(dup) => Probe::Duplicate(dup),
+            Ok(start) => {
+                // The would-be vertex ranks above every existing one, as a real insertion
+                // would.
+                self.find_cavity(p, self.points.len() as u32, start, &mut NoWatch);
+                self.probed(p, hint)
+            }
+        }
+    }
+
+    /// [`Self::probe`], showing `watch` the cavity's boundary faces as the search finds them:
+    /// None when `watch` stopped the search (the buffers then hold no cavity).
+    pub fn probe_watched(
+        &mut self,
+        p: DVec3,
+        hint: Option<u32>,
+        watch: &mut impl CavityWatch,
+    ) -> Option<Probe> {
+        match self.start_probe(p, hint) {
+            Err(dup) => Some(Probe::Duplicate(dup)),
+            Ok(start) => self
+                .find_cavity(p, self.points.len() as u32, start, watch)
+                .then(|| self.probed(p, hint)),
+        }
+    }
+
+    /// Locates `p` from `hint` for a probe: the tet the search starts from, or the vertex at p.
+    fn start_probe(&mut self, p: DVec3, hint: Option<u32>) -> Result<u32, u32> {
         let start = hint.filter(|&t| self.is_alive(t)).unwrap_or(self.last);
         let start = self.locate(p, start);
-        if let Some(dup) = self.coincident_vertex(start, p) {
-            self.scratch.probed = None;
-            return Probe::Duplicate(dup);
+        match self.coincident_vertex(start, p) {
+            Some(dup) => {
+                self.scratch.probed = None;
+                Err(dup)
+            }
+            None => Ok(start),
         }
-        // The would-be vertex ranks above every existing one, as a real insertion would.
-        self.find_cavity(p, self.points.len() as u32, start);
+    }
+
+    /// The token of the cavity of `p` the buffers now hold.
+    fn probed(&mut self, p: DVec3, hint: Option<u32>) -> Probe {
         self.scratch.probed = Some(p);
         Probe::Cavity(Cavity {
             p,
@@ -260,7 +321,17 @@ impl Delaunay {
     /// Breadth-first, with the cavity list as the queue: when a tet joins the cavity its
     /// neighbours' records and marks are prefetched, and they are usually in cache by the time
     /// it is dequeued and they are tested.
-    fn find_cavity(&mut self, p: DVec3, rank: u32, start: u32) {
+    ///
+    /// `watch` sees the boundary faces in batches of [`WATCH_BATCH`] as they are found (a face
+    /// found is final: the tet behind it stays outside) and the rest at the end; when it
+    /// returns false the search stops, and false is returned.
+    fn find_cavity<W: CavityWatch>(
+        &mut self,
+        p: DVec3,
+        rank: u32,
+        start: u32,
+        watch: &mut W,
+    ) -> bool {
         let mut s = std::mem::take(&mut self.scratch);
         s.probed = None;
         s.cavity.clear();
@@ -270,7 +341,17 @@ impl Delaunay {
         s.cavity.push(start);
         s.entry.push(4);
         let mut head = 0;
+        let mut watched = 0;
+        let mut stopped = false;
         while head < s.cavity.len() {
+            if W::WATCHES && s.boundary.len() - watched >= WATCH_BATCH {
+                let upto = s.boundary.len() - (s.boundary.len() - watched) % WATCH_BATCH;
+                if !watch.faces(&s.boundary[watched..upto], &self.points) {
+                    stopped = true;
+                    break;
+                }
+                watched = upto;
+            }
             let t = s.cavity[head];
             head += 1;
             let Tet { v, n: nb } = *self.tet_ref(t);
@@ -339,14 +420,23 @@ impl Delaunay {
                 }
             }
         }
-        // Leave every mark at zero for the next search.
+        if W::WATCHES && !stopped {
+            stopped = !watch.faces(&s.boundary[watched..], &self.points);
+        }
+        // Leave every mark at zero for the next search (a stopped one marked only tets in
+        // these lists too).
         for &t in &s.cavity {
             *self.mark_mut(t) = 0;
         }
         for f in &s.boundary {
             *self.mark_mut(f.outer >> 2) = 0;
         }
+        if stopped {
+            s.cavity.clear();
+            s.boundary.clear();
+        }
         self.scratch = s;
+        !stopped
     }
 
     /// One neighbour of a dequeued finite cavity tet `t` (vertices `v`): the neighbour across

@@ -494,3 +494,73 @@ fn edge_ring_is_every_tet_holding_the_edge() {
     }
     assert!(edges > 500, "{edges}");
 }
+
+/// Counts the faces a watched probe shows, stopping after `stop_after` (None: never).
+struct FaceCounter {
+    seen: Vec<[u32; 3]>,
+    stop_after: Option<usize>,
+}
+
+impl CavityWatch for FaceCounter {
+    fn faces(&mut self, faces: &[BoundaryFace], points: &[DVec3]) -> bool {
+        assert!(faces.iter().all(|f| f
+            .vertices()
+            .iter()
+            .all(|&v| v == INFINITE || (v as usize) < points.len())));
+        self.seen.extend(faces.iter().map(|f| f.vertices()));
+        self.stop_after.is_none_or(|n| self.seen.len() <= n)
+    }
+}
+
+#[test]
+fn a_watched_probe_shows_every_boundary_face_once_and_a_stopped_one_leaves_no_trace() {
+    let pts = uniform(3000, 21);
+    let (mut dt, _) = Delaunay::from_points(&pts).unwrap();
+    let reference = dt.clone();
+    let mut stopped = 0;
+    for (k, p) in uniform(300, 22).into_iter().enumerate() {
+        // Points outside the hull too (hull tets in the cavity).
+        let p = if k % 5 == 0 { p * 1.5 - 0.25 } else { p };
+        let mut all = FaceCounter {
+            seen: vec![],
+            stop_after: None,
+        };
+        let Some(Probe::Cavity(c)) = dt.probe_watched(p, None, &mut all) else {
+            panic!("an unstopped probe of a new point gives its cavity");
+        };
+        let mut faces: Vec<[u32; 3]> = dt.cavity(&c).1.iter().map(|f| f.vertices()).collect();
+        faces.sort_unstable();
+        all.seen.sort_unstable();
+        assert_eq!(all.seen, faces, "point {k}");
+        // Stopped at various points of the search, including at its end.
+        let mut some = FaceCounter {
+            seen: vec![],
+            stop_after: Some(k % faces.len()),
+        };
+        if dt.probe_watched(p, None, &mut some).is_none() {
+            stopped += 1;
+            // The marks were reset: the next search and an insertion are as without it.
+            let again = probed(&mut dt, p);
+            let mut faces_again: Vec<[u32; 3]> =
+                dt.cavity(&again).1.iter().map(|f| f.vertices()).collect();
+            faces_again.sort_unstable();
+            assert_eq!(faces_again, faces, "point {k} after a stopped probe");
+        }
+    }
+    assert!(stopped > 250, "{stopped} probes stopped");
+    // Probing changed nothing.
+    assert_eq!(sorted_tets(&dt), sorted_tets(&reference));
+    let mut inserted = dt.clone();
+    let mut plain = reference;
+    for p in uniform(100, 23) {
+        let mut stop = FaceCounter {
+            seen: vec![],
+            stop_after: Some(3),
+        };
+        assert!(inserted.probe_watched(p, None, &mut stop).is_none());
+        inserted.insert(p, None).unwrap();
+        plain.insert(p, None).unwrap();
+    }
+    inserted.validate().unwrap();
+    assert_eq!(sorted_tets(&inserted), sorted_tets(&plain));
+}

@@ -17,7 +17,7 @@
 
 use super::outcome::{Outcome, Refusal};
 use super::MeshError;
-use crate::delaunay::{BoundaryFace, Cavity, Delaunay, Probe, INFINITE};
+use crate::delaunay::{BoundaryFace, Cavity, CavityWatch, Delaunay, Probe, INFINITE};
 use crate::geom::circumsphere;
 use crate::geom::screen::{shortest_edge_sq, sliver_measures, SliverScreen};
 use glam::DVec3;
@@ -197,42 +197,26 @@ impl Picker {
         centre + random_in_unit_ball(&mut self.rng) * (self.delta * r)
     }
 
-    /// The small slivers (circumradius <= b r) inserting the probed point would create; None
-    /// as soon as there are more than `limit`.
-    pub fn small_slivers(
-        &self,
-        dt: &Delaunay,
-        cavity: &Cavity,
-        r: f64,
-        limit: Option<usize>,
-    ) -> Option<Score> {
-        let mut score = Score {
-            n_small: 0,
-            margin: f64::INFINITY,
-        };
-        let max_r = self.b * r;
-        let p = cavity.point();
-        let faces = dt.cavity(cavity).1;
-        let points = dt.points();
-        let corners = |f: &BoundaryFace| {
-            let v = f.vertices();
-            (!v.contains(&INFINITE)).then(|| v.map(|v| points[v as usize]))
-        };
-        let mut over = false;
-        // The sliver screen first (most new tets pass it), then the full measures.
-        self.screen
-            .for_each_uncleared(faces, corners, p, |[x, y, z]| {
-                if let Some(margin) = self.small_sliver(x, y, z, p, max_r) {
-                    score.n_small += 1;
-                    if limit.is_some_and(|m| score.n_small > m) {
-                        over = true;
-                        return false;
-                    }
-                    score.margin = score.margin.min(margin);
-                }
-                true
-            });
-        (!over).then_some(score)
+    /// The small slivers (circumradius <= b r) inserting the probed point would create.
+    pub fn small_slivers(&self, dt: &Delaunay, cavity: &Cavity, r: f64) -> Score {
+        let mut count = self.sliver_count(cavity.point(), r, None);
+        count.faces(dt.cavity(cavity).1, dt.points());
+        count.score
+    }
+
+    /// A count of the small slivers of a point `p` for an element of radius `r`, to watch its
+    /// cavity search; it stops the search at more than `limit`.
+    fn sliver_count(&self, p: DVec3, r: f64, limit: Option<usize>) -> SliverCount<'_> {
+        SliverCount {
+            picker: self,
+            p,
+            max_r: self.b * r,
+            limit,
+            score: Score {
+                n_small: 0,
+                margin: f64::INFINITY,
+            },
+        }
     }
 
     /// For the new tet (x, y, z, p): 1 - cos(its smallest dihedral angle) if it is a sliver
@@ -242,6 +226,43 @@ impl Picker {
         let (sigma, max_cos) = sliver_measures(x, y, z, p, shortest_edge_sq(x, y, z, p));
         let small = circumsphere(x, y, z, p).map_or(f64::INFINITY, |s| s.1) <= max_r;
         (self.slivers.is_sliver(sigma, max_cos) && small).then(|| max_cos.mul_add(-1.0, 1.0))
+    }
+}
+
+/// Counts the small slivers of a candidate point's new tets as its cavity search finds them.
+struct SliverCount<'a> {
+    picker: &'a Picker,
+    p: DVec3,
+    max_r: f64,
+    limit: Option<usize>,
+    score: Score,
+}
+
+impl CavityWatch for SliverCount<'_> {
+    /// False once there are more than `limit` small slivers: the candidate cannot win.
+    fn faces(&mut self, faces: &[BoundaryFace], points: &[DVec3]) -> bool {
+        let corners = |f: &BoundaryFace| {
+            let v = f.vertices();
+            (!v.contains(&INFINITE)).then(|| v.map(|v| points[v as usize]))
+        };
+        let mut over = false;
+        // The sliver screen first (most new tets pass it), then the full measures.
+        let (picker, p, max_r, limit) = (self.picker, self.p, self.max_r, self.limit);
+        let score = &mut self.score;
+        picker
+            .screen
+            .for_each_uncleared(faces, corners, p, |[x, y, z]| {
+                if let Some(margin) = picker.small_sliver(x, y, z, p, max_r) {
+                    score.n_small += 1;
+                    if limit.is_some_and(|m| score.n_small > m) {
+                        over = true;
+                        return false;
+                    }
+                    score.margin = score.margin.min(margin);
+                }
+                true
+            });
+        !over
     }
 }
 
@@ -258,13 +279,15 @@ pub(crate) fn try_candidate<F: FacetLevel + ?Sized>(
     check_conflict: bool,
     best: &mut Option<Candidate>,
 ) -> bool {
-    let Probe::Cavity(cavity) = level.triangulation().probe(p, hint) else {
-        return false;
-    };
     let limit = best.as_ref().map(|b| b.score.n_small);
-    let Some(score) = picker.small_slivers(level.triangulation(), &cavity, r, limit) else {
+    let mut count = picker.sliver_count(p, r, limit);
+    let Some(probe) = level.triangulation().probe_watched(p, hint, &mut count) else {
         return false; // more small slivers than the best
     };
+    let Probe::Cavity(cavity) = probe else {
+        return false;
+    };
+    let score = count.score;
     if best.as_ref().is_some_and(|b| !score.better_than(&b.score)) {
         return false; // not better: whether it breaks the boundary does not matter
     }
@@ -291,9 +314,8 @@ pub(crate) fn pick_in_ball<F: FacetLevel + ?Sized>(
     // The centre is a point of the picking ball too, and its cavity is at hand: the first
     // candidate.
     if let Some(cavity) = centre_cavity {
-        if let Some(score) = picker.small_slivers(level.triangulation(), &cavity, r, None) {
-            best = Some(Candidate { score, cavity });
-        }
+        let score = picker.small_slivers(level.triangulation(), &cavity, r);
+        best = Some(Candidate { score, cavity });
     }
     if best.as_ref().is_none_or(|b| b.score.n_small > 0) {
         for draws in 0..picker.max_tries {
