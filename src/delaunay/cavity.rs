@@ -34,6 +34,17 @@ pub(super) struct Scratch {
     /// any other search or edit. Only a [`Cavity`] token for this point (and the current
     /// generation) reads or inserts them.
     probed: Option<DVec3>,
+    /// A copy of one probed cavity, kept while other points are probed ([`Delaunay::keep`]).
+    kept: KeptCavity,
+}
+
+/// See [`Delaunay::keep`].
+#[derive(Debug, Clone, Default)]
+struct KeptCavity {
+    /// The probed point and the generation of the probe (None: nothing kept).
+    of: Option<(DVec3, u64)>,
+    cavity: Vec<u32>,
+    boundary: Vec<BoundaryFace>,
 }
 
 impl Scratch {
@@ -46,6 +57,8 @@ impl Scratch {
             + self.removed_ids.capacity() * 4
             + self.tags.capacity() * 4
             + self.edges.memory_bytes()
+            + self.kept.cavity.capacity() * 4
+            + self.kept.boundary.capacity() * std::mem::size_of::<BoundaryFace>()
     }
 }
 
@@ -240,6 +253,21 @@ impl Delaunay {
         })
     }
 
+    /// Keeps a copy of `cavity`'s cavity (when its token is current) for
+    /// [`Self::insert_cavity`] to use after other probes, if nothing is edited in between: one
+    /// candidate kept while others are tried is inserted without a new search. (The copy
+    /// replaces the one kept before.) Only a probe from a hint is kept: the search the
+    /// insertion would make afresh starts at the same (alive) tet and finds the same cavity in
+    /// the same order, so the copy changes the work and nothing else.
+    pub fn keep(&mut self, cavity: &Cavity) {
+        if cavity.hint.is_some() && self.is_current(cavity) {
+            let s = &mut self.scratch;
+            s.kept.of = Some((cavity.p, cavity.generation));
+            s.kept.cavity.clone_from(&s.cavity);
+            s.kept.boundary.clone_from(&s.boundary);
+        }
+    }
+
     /// Whether the buffers still hold `cavity`'s cavity: no edit since its probe, and the last
     /// probe was of the same point.
     #[inline]
@@ -264,7 +292,20 @@ impl Delaunay {
     /// probe's hint like [`Self::insert`].
     pub fn insert_cavity(&mut self, cavity: Cavity) -> Result<Inserted, DelaunayError> {
         if !self.is_current(&cavity) {
-            return self.insert(cavity.p, cavity.hint);
+            let s = &mut self.scratch;
+            if s.kept.of != Some((cavity.p, cavity.generation))
+                || cavity.generation != self.generation
+            {
+                return self.insert(cavity.p, cavity.hint);
+            }
+            std::mem::swap(&mut s.cavity, &mut s.kept.cavity);
+            std::mem::swap(&mut s.boundary, &mut s.kept.boundary);
+            s.kept.of = None;
+            // The walk a fresh search would take, for the walks' random choices that follow
+            // (it is short: the probe's hint is near p).
+            if let Some(hint) = cavity.hint.filter(|&t| self.is_alive(t)) {
+                self.locate(cavity.p, hint);
+            }
         }
         let id = self.push_vertex(cavity.p)?;
         // The probe ranked the would-be vertex `points.len()` before the push: `id`. (No

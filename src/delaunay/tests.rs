@@ -564,3 +564,44 @@ fn a_watched_probe_shows_every_boundary_face_once_and_a_stopped_one_leaves_no_tr
     inserted.validate().unwrap();
     assert_eq!(sorted_tets(&inserted), sorted_tets(&plain));
 }
+
+/// Every tet slot: its vertices and neighbour references (dead ones too), ids included.
+fn slots(dt: &Delaunay) -> Vec<([u32; 4], [u32; 4])> {
+    dt.tets.iter().map(|t| (t.v, t.n)).collect()
+}
+
+#[test]
+fn inserting_a_kept_cavity_after_other_probes_is_a_fresh_insertion_exactly() {
+    let pts = uniform(2000, 31);
+    let (mut kept, _) = Delaunay::from_points(&pts).unwrap();
+    let mut fresh = kept.clone();
+    let mut rng = ChaCha8Rng::seed_from_u64(32);
+    let mut used = 0;
+    for k in 0..150 {
+        let p = DVec3::new(rng.gen(), rng.gen(), rng.gen());
+        let others: Vec<DVec3> = (0..k % 4)
+            .map(|_| p + DVec3::new(rng.gen(), rng.gen(), rng.gen()) * 0.02)
+            .collect();
+        let hint = (k % 5 != 0).then(|| kept.finite_tet_ids().nth(k * 7).unwrap());
+        let start = hint.map(|h| kept.tet(h));
+        for (keeps, dt) in [(true, &mut kept), (false, &mut fresh)] {
+            assert_eq!(hint.map(|h| dt.tet(h)), start);
+            let Probe::Cavity(c) = dt.probe(p, hint) else {
+                panic!("a new point");
+            };
+            if keeps {
+                dt.keep(&c);
+            }
+            for &q in &others {
+                dt.probe(q, hint);
+            }
+            dt.insert_cavity(c).unwrap();
+        }
+        used += usize::from(hint.is_some() && !others.is_empty());
+        // The same tets in the same slots, and the same walks to come.
+        assert_eq!(slots(&kept), slots(&fresh), "point {k}");
+        assert_eq!(kept.rng, fresh.rng, "point {k}: the walks' random state");
+    }
+    assert!(used > 80);
+    kept.validate().unwrap();
+}

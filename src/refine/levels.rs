@@ -294,6 +294,8 @@ pub(crate) fn try_candidate<F: FacetLevel + ?Sized>(
     if check_conflict && level.encroached(&cavity).is_some() {
         return false; // p would break the boundary
     }
+    // Inserting the best needs no second search.
+    level.triangulation().keep(&cavity);
     *best = Some(Candidate { score, cavity });
     score.n_small == 0
 }
@@ -315,6 +317,7 @@ pub(crate) fn pick_in_ball<F: FacetLevel + ?Sized>(
     // candidate.
     if let Some(cavity) = centre_cavity {
         let score = picker.small_slivers(level.triangulation(), &cavity, r);
+        level.triangulation().keep(&cavity);
         best = Some(Candidate { score, cavity });
     }
     if best.as_ref().is_none_or(|b| b.score.n_small > 0) {
