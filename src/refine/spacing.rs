@@ -149,7 +149,9 @@ impl AutoSpacing {
     }
 
     /// Two chamfer sweeps (forward, backward) over the 26-neighbourhood enforce
-    /// f(x) <= f(y) + ALPHA |x - y| between neighbouring cells.
+    /// f(x) <= f(y) + ALPHA |x - y| between neighbouring cells: the shortest chains of steps
+    /// run straight, in steps the forward sweep takes and steps the backward one takes, in
+    /// either order (a second pair of sweeps changes values by rounding only).
     fn propagate(&mut self) {
         let [nx, ny, nz] = self.dims;
         let idx = |i: usize, j: usize, k: usize| (k * ny + j) * nx + i;
@@ -172,57 +174,53 @@ impl AutoSpacing {
             .map(|&(di, dj, dk, _)| (di + (dj + dk * ny as i64) * nx as i64) as isize)
             .collect();
         let adds: Vec<f64> = neighbours.map(|st| st.3).collect();
-        for _ in 0..2 {
-            for pass in 0..2 {
-                for kk in 0..nz {
-                    for jj in 0..ny {
-                        for ii in 0..nx {
-                            let (i, j, k) = if pass == 0 {
-                                (ii, jj, kk)
-                            } else {
-                                (nx - 1 - ii, ny - 1 - jj, nz - 1 - kk)
-                            };
-                            // A sweep takes the neighbours it has passed already (the
-                            // half of the 26 before the cell in its order).
-                            let half = if pass == 0 { 0..13 } else { 13..26 };
-                            let mut best = self.value[idx(i, j, k)];
-                            let interior =
-                                i > 0 && j > 0 && k > 0 && i + 1 < nx && j + 1 < ny && k + 1 < nz;
-                            if interior {
-                                // No bounds to check; a plain comparison (no NaN here).
-                                let at = idx(i, j, k);
-                                let half = half.clone();
-                                for (&offset, &add) in offsets[half.clone()].iter().zip(&adds[half])
-                                {
-                                    let x = self.value[at.wrapping_add_signed(offset)] + add;
-                                    if x < best {
-                                        best = x;
-                                    }
+        for pass in 0..2 {
+            for kk in 0..nz {
+                for jj in 0..ny {
+                    for ii in 0..nx {
+                        let (i, j, k) = if pass == 0 {
+                            (ii, jj, kk)
+                        } else {
+                            (nx - 1 - ii, ny - 1 - jj, nz - 1 - kk)
+                        };
+                        // A sweep takes the neighbours it has passed already (the
+                        // half of the 26 before the cell in its order).
+                        let half = if pass == 0 { 0..13 } else { 13..26 };
+                        let mut best = self.value[idx(i, j, k)];
+                        let interior =
+                            i > 0 && j > 0 && k > 0 && i + 1 < nx && j + 1 < ny && k + 1 < nz;
+                        if interior {
+                            // No bounds to check; a plain comparison (no NaN here).
+                            let at = idx(i, j, k);
+                            for (&offset, &add) in offsets[half.clone()].iter().zip(&adds[half]) {
+                                let x = self.value[at.wrapping_add_signed(offset)] + add;
+                                if x < best {
+                                    best = x;
                                 }
-                                self.value[idx(i, j, k)] = best;
-                                continue;
-                            }
-                            let near = if pass == 0 {
-                                &steps[..13]
-                            } else {
-                                &steps[14..]
-                            };
-                            for &(di, dj, dk, add) in near {
-                                let (a, b, c) = (i as i64 + di, j as i64 + dj, k as i64 + dk);
-                                if a < 0
-                                    || b < 0
-                                    || c < 0
-                                    || a >= nx as i64
-                                    || b >= ny as i64
-                                    || c >= nz as i64
-                                {
-                                    continue;
-                                }
-                                best = best
-                                    .min(self.value[idx(a as usize, b as usize, c as usize)] + add);
                             }
                             self.value[idx(i, j, k)] = best;
+                            continue;
                         }
+                        let near = if pass == 0 {
+                            &steps[..13]
+                        } else {
+                            &steps[14..]
+                        };
+                        for &(di, dj, dk, add) in near {
+                            let (a, b, c) = (i as i64 + di, j as i64 + dj, k as i64 + dk);
+                            if a < 0
+                                || b < 0
+                                || c < 0
+                                || a >= nx as i64
+                                || b >= ny as i64
+                                || c >= nz as i64
+                            {
+                                continue;
+                            }
+                            best =
+                                best.min(self.value[idx(a as usize, b as usize, c as usize)] + add);
+                        }
+                        self.value[idx(i, j, k)] = best;
                     }
                 }
             }
