@@ -205,8 +205,9 @@ impl Picker {
     }
 
     /// A count of the small slivers of a point `p` for an element of radius `r`, to watch its
-    /// cavity search; it stops the search at more than `limit`.
-    fn sliver_count(&self, p: DVec3, r: f64, limit: Option<usize>) -> SliverCount<'_> {
+    /// cavity search; it stops the search once the point cannot beat `limit` (the best
+    /// candidate's score).
+    fn sliver_count(&self, p: DVec3, r: f64, limit: Option<Score>) -> SliverCount<'_> {
         SliverCount {
             picker: self,
             p,
@@ -234,12 +235,13 @@ struct SliverCount<'a> {
     picker: &'a Picker,
     p: DVec3,
     max_r: f64,
-    limit: Option<usize>,
+    limit: Option<Score>,
     score: Score,
 }
 
 impl CavityWatch for SliverCount<'_> {
-    /// False once there are more than `limit` small slivers: the candidate cannot win.
+    /// False once the candidate cannot beat `limit`: more small slivers, or as many with a
+    /// smallest margin no larger (either only grows worse as faces come).
     fn faces(&mut self, faces: &[BoundaryFace], points: &[DVec3]) -> bool {
         let corners = |f: &BoundaryFace| {
             let v = f.vertices();
@@ -254,11 +256,11 @@ impl CavityWatch for SliverCount<'_> {
             .for_each_uncleared(faces, corners, p, |[x, y, z]| {
                 if let Some(margin) = picker.small_sliver(x, y, z, p, max_r) {
                     score.n_small += 1;
-                    if limit.is_some_and(|m| score.n_small > m) {
+                    score.margin = score.margin.min(margin);
+                    if limit.is_some_and(|b| !score.better_than(&b)) {
                         over = true;
                         return false;
                     }
-                    score.margin = score.margin.min(margin);
                 }
                 true
             });
@@ -279,7 +281,7 @@ pub(crate) fn try_candidate<F: FacetLevel + ?Sized>(
     check_conflict: bool,
     best: &mut Option<Candidate>,
 ) -> bool {
-    let limit = best.as_ref().map(|b| b.score.n_small);
+    let limit = best.as_ref().map(|b| b.score);
     let mut count = picker.sliver_count(p, r, limit);
     let Some(probe) = level.triangulation().probe_watched(p, hint, &mut count) else {
         return false; // more small slivers than the best
