@@ -128,20 +128,21 @@ pub trait CavityWatch {
     /// Whether the search shows this watch anything (false: the calls compile away).
     const WATCHES: bool = true;
 
+    /// While the search runs, boundary faces come in multiples of this many (the rest at its
+    /// end).
+    const BATCH: usize;
+
     /// Boundary faces found since the last call, with the triangulation's points (a face with
     /// `INFINITE` makes a hull tet); false stops the search.
     fn faces(&mut self, faces: &[BoundaryFace], points: &[DVec3]) -> bool;
 }
-
-/// Boundary faces go to a [`CavityWatch`] in multiples of this many while the search runs
-/// (the sliver screen's batch).
-pub const WATCH_BATCH: usize = 8;
 
 /// The watch of a plain search.
 struct NoWatch;
 
 impl CavityWatch for NoWatch {
     const WATCHES: bool = false;
+    const BATCH: usize = 1;
 
     #[inline(always)]
     fn faces(&mut self, _: &[BoundaryFace], _: &[DVec3]) -> bool {
@@ -363,7 +364,7 @@ impl Delaunay {
     /// neighbours' records and marks are prefetched, and they are usually in cache by the time
     /// it is dequeued and they are tested.
     ///
-    /// `watch` sees the boundary faces in batches of [`WATCH_BATCH`] as they are found (a face
+    /// `watch` sees the boundary faces in batches of its `BATCH` as they are found (a face
     /// found is final: the tet behind it stays outside) and the rest at the end; when it
     /// returns false the search stops, and false is returned.
     fn find_cavity<W: CavityWatch>(
@@ -385,8 +386,8 @@ impl Delaunay {
         let mut watched = 0;
         let mut stopped = false;
         while head < s.cavity.len() {
-            if W::WATCHES && s.boundary.len() - watched >= WATCH_BATCH {
-                let upto = s.boundary.len() - (s.boundary.len() - watched) % WATCH_BATCH;
+            if W::WATCHES && s.boundary.len() - watched >= W::BATCH {
+                let upto = s.boundary.len() - (s.boundary.len() - watched) % W::BATCH;
                 if !watch.faces(&s.boundary[watched..upto], &self.points) {
                     stopped = true;
                     break;

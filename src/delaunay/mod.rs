@@ -19,7 +19,7 @@ pub mod tables;
 mod validate;
 
 use crate::geom::{self, orient3d};
-pub use cavity::{BoundaryFace, Cavity, CavityWatch, DryRun, Probe, WATCH_BATCH};
+pub use cavity::{BoundaryFace, Cavity, CavityWatch, DryRun, Probe};
 use glam::DVec3;
 use tables::FACE;
 

@@ -502,6 +502,9 @@ struct FaceCounter {
 }
 
 impl CavityWatch for FaceCounter {
+    // Not the sliver screen's 8: any batch size works.
+    const BATCH: usize = 5;
+
     fn faces(&mut self, faces: &[BoundaryFace], points: &[DVec3]) -> bool {
         assert!(faces.iter().all(|f| f
             .vertices()

@@ -80,6 +80,9 @@ pub struct SliverScreen {
 }
 
 impl SliverScreen {
+    /// Tets screened together by [`Self::for_each_uncleared`] (lanes of one vectorized pass).
+    pub const BATCH: usize = 8;
+
     const MARGIN: f64 = 1e-6;
 
     /// The screen for the bounds sigma >= `sigma0` and smallest dihedral angle >=
@@ -128,7 +131,7 @@ impl SliverScreen {
         p: DVec3,
         mut f: impl FnMut([DVec3; 3]) -> bool,
     ) {
-        const BATCH: usize = 8;
+        const BATCH: usize = SliverScreen::BATCH;
         for batch in faces.chunks(BATCH) {
             // Skipped lanes and those beyond the batch stay zero (flat: never cleared).
             let mut q = [[0.0f64; BATCH]; 9];

@@ -240,6 +240,8 @@ struct SliverCount<'a> {
 }
 
 impl CavityWatch for SliverCount<'_> {
+    const BATCH: usize = SliverScreen::BATCH;
+
     /// False once the candidate cannot beat `limit`: more small slivers, or as many with a
     /// smallest margin no larger (either only grows worse as faces come).
     fn faces(&mut self, faces: &[BoundaryFace], points: &[DVec3]) -> bool {
