@@ -167,13 +167,16 @@ impl AutoSpacing {
                 }
             }
         }
-        // The 26 neighbours of an interior cell as index offsets, and what each step adds.
-        let neighbours = steps.iter().filter(|st| (st.0, st.1, st.2) != (0, 0, 0));
-        let offsets: Vec<isize> = neighbours
-            .clone()
-            .map(|&(di, dj, dk, _)| (di + (dj + dk * ny as i64) * nx as i64) as isize)
-            .collect();
-        let adds: Vec<f64> = neighbours.map(|st| st.3).collect();
+        // A sweep takes the neighbours it has passed already: the forward one the 13 before a
+        // cell in index order (the steps before the centre, `steps[13]`), the backward one the
+        // 13 after. For interior cells, as index offsets and what each step adds.
+        let halves = [&steps[..13], &steps[14..]];
+        let offsets = halves.map(|half| -> Vec<isize> {
+            half.iter()
+                .map(|&(di, dj, dk, _)| (di + (dj + dk * ny as i64) * nx as i64) as isize)
+                .collect()
+        });
+        let adds = halves.map(|half| -> Vec<f64> { half.iter().map(|st| st.3).collect() });
         for pass in 0..2 {
             for kk in 0..nz {
                 for jj in 0..ny {
@@ -183,16 +186,13 @@ impl AutoSpacing {
                         } else {
                             (nx - 1 - ii, ny - 1 - jj, nz - 1 - kk)
                         };
-                        // A sweep takes the neighbours it has passed already (the
-                        // half of the 26 before the cell in its order).
-                        let half = if pass == 0 { 0..13 } else { 13..26 };
                         let mut best = self.value[idx(i, j, k)];
                         let interior =
                             i > 0 && j > 0 && k > 0 && i + 1 < nx && j + 1 < ny && k + 1 < nz;
                         if interior {
                             // No bounds to check; a plain comparison (no NaN here).
                             let at = idx(i, j, k);
-                            for (&offset, &add) in offsets[half.clone()].iter().zip(&adds[half]) {
+                            for (&offset, &add) in offsets[pass].iter().zip(&adds[pass]) {
                                 let x = self.value[at.wrapping_add_signed(offset)] + add;
                                 if x < best {
                                     best = x;
@@ -201,12 +201,7 @@ impl AutoSpacing {
                             self.value[idx(i, j, k)] = best;
                             continue;
                         }
-                        let near = if pass == 0 {
-                            &steps[..13]
-                        } else {
-                            &steps[14..]
-                        };
-                        for &(di, dj, dk, add) in near {
+                        for &(di, dj, dk, add) in halves[pass] {
                             let (a, b, c) = (i as i64 + di, j as i64 + dj, k as i64 + dk);
                             if a < 0
                                 || b < 0
