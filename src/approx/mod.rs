@@ -24,7 +24,7 @@ pub use curves::SMALL_CORNER_DEG;
 use crate::mesh::TetMesh;
 use crate::plc::{CellKind, Facet, PlcInput};
 use crate::refine::{
-    ConstantSpacing, MeshError, Params, Progress, Report, Spacing,
+    AutoSpacing, ConstantSpacing, MeshError, Params, Progress, Report, Spacing,
     DEFAULT_SURFACE_DISTANCE_FRACTION,
 };
 use crate::surface::features::{FeatureParams, Features};
@@ -88,7 +88,8 @@ pub fn mesh(
     progress: Option<Progress>,
 ) -> Result<(TetMesh, Report), MeshError> {
     let start = std::time::Instant::now();
-    let (remeshed, mesh, mut report) = mesh_restricted(input, params, spacing, progress)?;
+    let (remeshed, mesh, mut report, cell_spacing) =
+        mesh_restricted(input, params, spacing, progress)?;
     let oracle = &remeshed.oracle;
     let slide = SurfaceSlide {
         oracle,
@@ -97,11 +98,25 @@ pub fn mesh(
         vertex_slide: &remeshed.vertex_slide,
         distance: DISTANCE_SAFETY * remeshed.distance,
     };
-    let mesh = crate::improve::finish(mesh, &mut report, None, params, Some(&slide))?;
+    let default_spacing =
+        ConstantSpacing(DEFAULT_SPACING_FRACTION * remeshed.surface.bbox_diagonal());
+    let f: &dyn Spacing = match (spacing, &cell_spacing) {
+        (Some(s), _) => s,
+        (None, Some(s)) => s,
+        (None, None) => &default_spacing,
+    };
+    let measure_final = |mesh: &TetMesh, report: &mut Report| {
+        measure_volume(mesh, f, params, &remeshed.small_corners, report)
+    };
+    let mesh = crate::improve::finish_with(
+        mesh,
+        &mut report,
+        None,
+        params,
+        Some(&slide),
+        Some(&measure_final),
+    )?;
     let mut surface_report = measure::surface_report(&remeshed, &mesh);
-    if report.stop_reason.is_none() {
-        report.stop_reason = remeshed.stop_reason.clone();
-    }
     (
         surface_report.n_bad_near_small_corners,
         surface_report.max_rho_away_from_small_corners,
@@ -109,6 +124,35 @@ pub fn mesh(
     report.surface = Some(surface_report);
     report.seconds_total = start.elapsed().as_secs_f64();
     Ok((mesh, report))
+}
+
+/// The report's figures of the final `mesh` (sizes against `f`), and whether it is complete:
+/// the surface was finished and every tet away from the small corners' protecting balls
+/// meets the bounds.
+fn measure_volume(
+    mesh: &TetMesh,
+    f: &dyn Spacing,
+    params: &Params,
+    small_corners: &[(glam::DVec3, f64)],
+    report: &mut Report,
+) -> Result<(), MeshError> {
+    let near = |t: &[u32; 4]| {
+        t.iter().any(|&v| {
+            let p = mesh.vertices[v as usize];
+            small_corners
+                .iter()
+                .any(|&(c, r)| (p - c).length_squared() <= r * r)
+        })
+    };
+    let (measured, bad_elsewhere) = crate::refine::report::measure(mesh, f, params, &near)?;
+    report.take_measures(measured);
+    report.complete = report.stop_reason.is_none() && bad_elsewhere == 0;
+    if report.stop_reason.is_none() && bad_elsewhere > 0 {
+        report.stop_reason = Some(format!(
+            "{bad_elsewhere} tets away from small corners still violate a bound"
+        ));
+    }
+    Ok(())
 }
 
 /// Where a boundary vertex may move during the improvement.
@@ -179,13 +223,15 @@ impl crate::improve::SurfaceSlide for SurfaceSlide<'_> {
 }
 
 /// Steps 3 and 4 in one triangulation: the restricted Delaunay surface, then its cells
-/// refined (`restricted::volume`).
+/// refined (`restricted::volume`). The report holds what is known before the improvement (its
+/// dihedral range, times, the surface's stop reason); the cells' automatic spacing, if any,
+/// comes along.
 fn mesh_restricted(
     input: &PlcInput,
     params: &Params,
     spacing: Option<&dyn Spacing>,
     progress: Option<Progress>,
-) -> Result<(Remeshed, TetMesh, Report), MeshError> {
+) -> Result<(Remeshed, TetMesh, Report, Option<AutoSpacing>), MeshError> {
     let crit = VolumeCriteria {
         rho0: params.rho0,
         sigma0: params.sigma0,
@@ -213,34 +259,26 @@ fn mesh_restricted(
             .collect(),
         boundary_markers: remeshed.boundary.facets.iter().map(|f| f.marker).collect(),
     };
-    let default_spacing =
-        ConstantSpacing(DEFAULT_SPACING_FRACTION * remeshed.surface.bbox_diagonal());
-    let f: &dyn Spacing = match (spacing, &volume.spacing) {
-        (Some(s), _) => s,
-        (None, Some(s)) => s,
-        (None, None) => &default_spacing,
+    let (min_dihedral_deg, max_dihedral_deg) = dihedral_range(&mesh);
+    let report = Report {
+        min_dihedral_deg,
+        max_dihedral_deg,
+        seconds_refinement: volume.seconds_volume,
+        seconds_total: start.elapsed().as_secs_f64(),
+        n_acute_angles: remeshed.small_corner_vertices.len(),
+        stop_reason: remeshed.stop_reason.clone(),
+        ..Report::default()
     };
-    let corners = &remeshed.small_corners;
-    let near = |t: &[u32; 4]| {
-        t.iter().any(|&v| {
-            let p = mesh.vertices[v as usize];
-            corners
-                .iter()
-                .any(|&(c, r)| (p - c).length_squared() <= r * r)
-        })
-    };
-    let (mut report, bad_elsewhere) = crate::refine::report::measure(&mesh, f, params, &near)?;
-    report.seconds_refinement = volume.seconds_volume;
-    report.seconds_total = start.elapsed().as_secs_f64();
-    report.n_acute_angles = remeshed.small_corner_vertices.len();
-    report.stop_reason = remeshed.stop_reason.clone();
-    report.complete = report.stop_reason.is_none() && bad_elsewhere == 0;
-    if report.stop_reason.is_none() && bad_elsewhere > 0 {
-        report.stop_reason = Some(format!(
-            "{bad_elsewhere} tets away from small corners still violate a bound"
-        ));
-    }
-    Ok((remeshed, mesh, report))
+    Ok((remeshed, mesh, report, volume.spacing))
+}
+
+/// Smallest and largest dihedral angle of `mesh`'s tets, degrees.
+fn dihedral_range(mesh: &TetMesh) -> (f64, f64) {
+    mesh.tets.iter().fold((180.0, 0.0), |(lo, hi), t| {
+        let [a, b, c, d] = t.map(|v| mesh.vertices[v as usize]);
+        let (l, h) = crate::geom::min_max_dihedral(a, b, c, d);
+        (lo.min(l), hi.max(h))
+    })
 }
 
 /// Steps 1-4: the new boundary and the tets inside it.

@@ -254,3 +254,47 @@ fn star_completes_at_user_sizes() {
         );
     }
 }
+
+/// The report's volume figures are those of the mesh returned (after the improvement moved
+/// and flipped it), measured here again from its tets.
+#[test]
+fn report_describes_the_improved_mesh() {
+    let h = 0.3;
+    let (mesh, report) = check_mesh("off/cube.off", Some(h));
+    assert!(!report.delaunay, "the improvement changed nothing: no test");
+    let p = |v: u32| mesh.vertices[v as usize];
+    let (mut size, mut lo, mut hi) = (0.0f64, 180.0f64, 0.0f64);
+    for t in &mesh.tets {
+        let [a, b, c, d] = t.map(p);
+        let (_, r) = crate::geom::circumsphere(a, b, c, d).unwrap();
+        size = size.max(r / h);
+        let (l, u) = crate::geom::min_max_dihedral(a, b, c, d);
+        (lo, hi) = (lo.min(l), hi.max(u));
+    }
+    let mut edges: Vec<[u32; 2]> = mesh
+        .tets
+        .iter()
+        .flat_map(|t| {
+            [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
+                .map(|(i, j)| [t[i].min(t[j]), t[i].max(t[j])])
+        })
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    let mut ratios: Vec<f64> = edges
+        .iter()
+        .map(|e| p(e[0]).distance(p(e[1])) / h)
+        .collect();
+    ratios.sort_by(f64::total_cmp);
+    let close = |x: f64, y: f64| (x - y).abs() <= 1e-9 * y.abs().max(1.0);
+    assert_eq!(report.n_tets, mesh.tets.len());
+    assert!(
+        close(report.max_size_ratio, size),
+        "{} {size}",
+        report.max_size_ratio
+    );
+    assert!(close(report.min_dihedral_deg, lo) && close(report.max_dihedral_deg, hi));
+    assert!(close(report.edge_ratio_min, ratios[0]));
+    assert!(close(report.edge_ratio_median, ratios[ratios.len() / 2]));
+    assert!(close(report.edge_ratio_max, ratios[ratios.len() - 1]));
+}

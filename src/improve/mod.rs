@@ -447,6 +447,11 @@ pub fn update_report(report: &mut Report, mesh: &TetMesh) {
     }
 }
 
+/// Measures an improved mesh into the report (all of its figures, not only the shapes that
+/// [`update_report`] re-measures): the approximate mode's closure, which knows the spacing and
+/// where quality is not enforced.
+pub type Remeasure<'a> = &'a dyn Fn(&TetMesh, &mut Report) -> Result<(), MeshError>;
+
 /// The step every mesher output goes through: improvement (or, with `params.improve` false,
 /// only the removal of flat and inverted tets; in approximate mode tets over `params.rho0`
 /// count as bad), the check that no tet is degenerate, and the
@@ -457,6 +462,20 @@ pub fn finish(
     input: Option<&PlcInput>,
     params: &crate::refine::Params,
     slide: Option<&dyn SurfaceSlide>,
+) -> Result<TetMesh, MeshError> {
+    finish_with(mesh, report, input, params, slide, None)
+}
+
+/// [`finish`], with the report measured on the result by `remeasure` (always, changed or not)
+/// instead of [`update_report`]. `report`'s dihedral range on entry is the mesh's before
+/// improvement.
+pub fn finish_with(
+    mesh: TetMesh,
+    report: &mut Report,
+    input: Option<&PlcInput>,
+    params: &crate::refine::Params,
+    slide: Option<&dyn SurfaceSlide>,
+    remeasure: Option<Remeasure>,
 ) -> Result<TetMesh, MeshError> {
     let opts = Options {
         improve: params.improve,
@@ -472,8 +491,10 @@ pub fn finish(
     let before = (report.min_dihedral_deg, report.max_dihedral_deg);
     let (out, stats) = improve_with(&mesh, input, &opts, slide);
     check_no_degenerate(&out)?;
-    if stats.changed() {
-        update_report(report, &out);
+    match remeasure {
+        Some(measure) => measure(&out, report)?,
+        None if stats.changed() => update_report(report, &out),
+        None => {}
     }
     report.delaunay = !stats.changed();
     report.dihedral_before_improve_deg = [before.0, before.1];

@@ -267,7 +267,9 @@ pub struct Report {
     pub max_dihedral_deg: f64,
     /// Tets with a dihedral angle below 5, 10, 15, 20 degrees.
     pub tets_below_deg: [usize; 4],
-    /// max over tets of R / f(circumcentre)
+    /// max over tets of R / f(circumcentre). This and the edge ratios describe the output
+    /// mesh in approximate mode; in keep mode they (and `n_bad_near_acute`) are the refined
+    /// mesh's before the improvement, which re-measures only the shape figures there.
     pub max_size_ratio: f64,
     /// edge length / f(midpoint): min, median, max
     pub edge_ratio_min: f64,

@@ -93,6 +93,24 @@ fn checked(spacing: &dyn Spacing, p: glam::DVec3) -> Result<f64, MeshError> {
 }
 
 impl Report {
+    /// Takes the figures [`measure`] fills in (counts, shapes, sizes, bad tets near small
+    /// angles) from `m`, a report it made; the rest of `self` stays.
+    pub fn take_measures(&mut self, m: Report) {
+        self.n_vertices = m.n_vertices;
+        self.n_tets = m.n_tets;
+        self.n_boundary_faces = m.n_boundary_faces;
+        self.max_rho = m.max_rho;
+        self.min_sigma = m.min_sigma;
+        self.min_dihedral_deg = m.min_dihedral_deg;
+        self.max_dihedral_deg = m.max_dihedral_deg;
+        self.tets_below_deg = m.tets_below_deg;
+        self.max_size_ratio = m.max_size_ratio;
+        self.edge_ratio_min = m.edge_ratio_min;
+        self.edge_ratio_median = m.edge_ratio_median;
+        self.edge_ratio_max = m.edge_ratio_max;
+        self.n_bad_near_acute = m.n_bad_near_acute;
+    }
+
     /// A human-readable table.
     pub fn table(&self) -> String {
         let mut s = String::new();
