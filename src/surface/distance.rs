@@ -46,24 +46,35 @@ pub fn samples(s: &InputSurface, spacing: f64) -> Vec<DVec3> {
 /// triangles would compute the same points.
 pub fn samples_per_edge_at_least(s: &InputSurface, spacing: f64, min_pieces: usize) -> Vec<DVec3> {
     assert!(spacing > 0.0, "sampling spacing must be positive");
-    let mut out = Vec::new();
+    // Each triangle's grid size (0: rows), decided once; the output reserved for all their
+    // samples, so that it is written once instead of copied through every doubling into fresh
+    // memory (a third of a run's page faults).
+    let mut bound = s.vertices.len();
+    let plans: Vec<u16> = (0..s.triangles.len())
+        .map(|t| {
+            let plan = Sampling::of(s.corners(t), spacing, min_pieces);
+            bound += plan.beyond_corners();
+            match plan {
+                Sampling::Rows(_) => 0,
+                Sampling::Grid(k) => k as u16,
+            }
+        })
+        .collect();
+    let mut out = Vec::with_capacity(bound);
     let mut vertex_done = vec![false; s.vertices.len()];
     // Edge (sorted ids) -> the number of pieces its grid points were taken with.
     let mut edge_done: FxHashMap<[u32; 2], usize> = FxHashMap::default();
     edge_done.reserve(s.triangles.len() * 3 / 2);
-    for t in 0..s.triangles.len() {
+    for (t, &pieces) in plans.iter().enumerate() {
         for v in s.triangles[t] {
             if !std::mem::replace(&mut vertex_done[v as usize], true) {
                 out.push(s.vertices[v as usize]);
             }
         }
         let [a, b, c] = s.corners(t);
-        let longest = (b - a).length().max((c - b).length()).max((a - c).length());
-        let k = ((longest / spacing).ceil() as usize).clamp(min_pieces.max(1), 4096);
-        let grid_samples = (k + 1) * (k + 2) / 2;
-        let rows = Rows::of([a, b, c], spacing / 3f64.sqrt());
-        if k > min_pieces && rows.count() < grid_samples {
-            rows.sample_inside(&mut out);
+        let k = pieces as usize;
+        if k == 0 {
+            Rows::of([a, b, c], spacing / 3f64.sqrt()).sample_inside(&mut out);
             continue;
         }
         let ids = s.triangles[t];
@@ -83,6 +94,38 @@ pub fn samples_per_edge_at_least(s: &InputSurface, spacing: f64, min_pieces: usi
         }
     }
     out
+}
+
+/// Most pieces a triangle's edge is cut into (a u16 holds it).
+const MAX_PIECES: usize = 4096;
+
+/// How one triangle is sampled: a barycentric grid with `k` pieces along each edge, or rows
+/// (a long thin triangle, where the rows take fewer samples).
+enum Sampling {
+    Grid(usize),
+    Rows(Rows),
+}
+
+impl Sampling {
+    fn of([a, b, c]: [DVec3; 3], spacing: f64, min_pieces: usize) -> Sampling {
+        let longest = (b - a).length().max((c - b).length()).max((a - c).length());
+        let k = ((longest / spacing).ceil() as usize).clamp(min_pieces.max(1), MAX_PIECES);
+        let grid_samples = (k + 1) * (k + 2) / 2;
+        let rows = Rows::of([a, b, c], spacing / 3f64.sqrt());
+        if k > min_pieces && rows.count() < grid_samples {
+            Sampling::Rows(rows)
+        } else {
+            Sampling::Grid(k)
+        }
+    }
+
+    /// At most this many samples besides the three corners (shared edges count for each side).
+    fn beyond_corners(&self) -> usize {
+        match self {
+            Sampling::Rows(rows) => rows.count(),
+            &Sampling::Grid(k) => (k + 1) * (k + 2) / 2 - 3,
+        }
+    }
 }
 
 /// Samples of a triangle along rows parallel to its longest edge `a`-`b`, at most `step`
