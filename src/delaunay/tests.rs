@@ -608,3 +608,89 @@ fn inserting_a_kept_cavity_after_other_probes_is_a_fresh_insertion_exactly() {
     assert!(used > 80);
     kept.validate().unwrap();
 }
+
+/// The circumsphere of finite tet `t`, as refinement computes it.
+fn tet_sphere(dt: &Delaunay, t: u32) -> Option<(DVec3, f64)> {
+    let [a, b, c, d] = dt.tet_points(t);
+    crate::geom::circumsphere(a, b, c, d)
+}
+
+/// The estimated cavity of a point of a picking ball shows the same boundary faces as its
+/// exact probe (random tets' picking balls, many draws each, faces watched in batches and
+/// stopped as a probe is); a ball that may reach beyond the hull gets no region, and skipping
+/// a probe leaves later walks and insertions as the probe would.
+#[test]
+fn estimated_cavities_are_the_exact_ones() {
+    let pts = uniform(3000, 31);
+    let (mut dt, _) = Delaunay::from_points(&pts).unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(32);
+    let tets: Vec<u32> = dt.finite_tet_ids().collect();
+    let (mut regions, mut hull_balls, mut draws) = (0, 0, 0);
+    for &t in tets.iter().step_by(23) {
+        let Some((centre, r)) = tet_sphere(&dt, t) else {
+            continue;
+        };
+        let radius = 0.3 * r;
+        let Some(mut region) = dt.ball_region(t, centre, radius, |u| tet_sphere(&dt, u)) else {
+            // Only balls near the hull (or too large a region) get none.
+            let lo = centre - DVec3::splat(radius);
+            let hi = centre + DVec3::splat(radius);
+            assert!(
+                lo.min_element() < 0.05 || hi.max_element() > 0.95 || r > 0.1,
+                "tet {t}: no region for an inner ball at {centre} radius {radius}"
+            );
+            hull_balls += 1;
+            continue;
+        };
+        regions += 1;
+        for k in 0..8 {
+            let p = centre + crate::refine::levels::random_in_unit_ball(&mut rng) * radius;
+            let mut estimated = FaceCounter {
+                seen: vec![],
+                stop_after: None,
+            };
+            assert!(dt.estimate_cavity_watched(&mut region, p, &mut estimated));
+            let mut exact = FaceCounter {
+                seen: vec![],
+                stop_after: None,
+            };
+            let Some(Probe::Cavity(_)) = dt.probe_watched(p, Some(t), &mut exact) else {
+                panic!("a random point is a new vertex");
+            };
+            estimated.seen.sort_unstable();
+            exact.seen.sort_unstable();
+            assert_eq!(estimated.seen, exact.seen, "tet {t}, draw {k}");
+            let mut stopped = FaceCounter {
+                seen: vec![],
+                stop_after: Some(k),
+            };
+            let n = exact.seen.len();
+            assert_eq!(
+                dt.estimate_cavity_watched(&mut region, p, &mut stopped),
+                k >= n,
+                "tet {t}, draw {k}: a watch stopping after {k} of {n} faces"
+            );
+            draws += 1;
+        }
+    }
+    assert!(
+        regions > 200 && hull_balls > 0,
+        "{regions} regions, {hull_balls} without"
+    );
+    assert!(draws > 1600);
+
+    // A skipped probe walks as the probe would: later insertions are the same.
+    let mut probing = dt.clone();
+    let mut skipping = dt;
+    for (k, p) in uniform(200, 33).into_iter().enumerate() {
+        let hint = Some(tets[k * 7 % tets.len()]).filter(|&t| probing.is_alive(t));
+        if k % 3 == 0 {
+            probing.insert(p, hint).unwrap();
+            skipping.insert(p, hint).unwrap();
+        } else {
+            probing.probe(p, hint);
+            skipping.skip_probe(p, hint);
+        }
+    }
+    assert_eq!(slots(&probing), slots(&skipping));
+}

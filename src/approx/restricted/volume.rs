@@ -98,7 +98,8 @@ impl SurfaceMesher<'_> {
                     crit.sigma0,
                     crit.min_dihedral_deg,
                 )
-                .giving_up(APPROX_GIVE_UP),
+                .giving_up(APPROX_GIVE_UP)
+                .estimating(),
             ),
             queues: Default::default(),
             deferrals: FxHashMap::default(),
