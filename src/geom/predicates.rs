@@ -548,7 +548,11 @@ impl W5 {
     }
 }
 
-/// Exact [`orient3d`] on a lattice (see above), `None` when the differences do not fit.
+/// Exact [`orient3d`] on a lattice (see above), `None` when the differences do not fit. On
+/// a finer lattice (|k| < 2^62: exactly coplanar points off a coarse lattice, as in the planar
+/// regions of a CAD surface whose triangle pairs validation tests) only an exact zero is
+/// decided here, in 3-word fixed point (2x2 minors < 2^125, terms < 2^187); robust gives any
+/// other value there, so every value is as robust's would be.
 #[inline(never)]
 fn orient3d_lattice(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Option<f64> {
     let diff = [
@@ -562,13 +566,22 @@ fn orient3d_lattice(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Option<f64> {
         exact_diff(b.z, d.z)?,
         exact_diff(c.z, d.z)?,
     ];
-    let (k, s) = lattice(diff, 40)?;
+    let (k, s) = lattice(diff, 62)?;
     let [adx, bdx, cdx, ady, bdy, cdy, adz, bdz, cdz] = k;
-    let det = adz * (bdx * cdy - cdx * bdy)
-        + bdz * (cdx * ady - adx * cdy)
-        + cdz * (adx * bdy - bdx * ady);
-    // Shewchuk's sign is the opposite of ours.
-    scaled(-det, 3 * s)
+    if k.iter().all(|x| x.unsigned_abs() < 1 << 40) {
+        let det = adz * (bdx * cdy - cdx * bdy)
+            + bdz * (cdx * ady - adx * cdy)
+            + cdz * (adx * bdy - bdx * ady);
+        // Shewchuk's sign is the opposite of ours.
+        return scaled(-det, 3 * s);
+    }
+    let m = |p: i128, q: i128, r: i128, t: i128| p * q - r * t;
+    let det = W3::mul(adz as i64, m(bdx, cdy, cdx, bdy))
+        .add(W3::mul(bdz as i64, m(cdx, ady, adx, cdy)))
+        .add(W3::mul(cdz as i64, m(adx, bdy, bdx, ady)));
+    // What robust gives for an exact zero (its full evaluation), negated as in
+    // `orient3d_exact`.
+    (det.0 == [0; 3]).then_some(-0.0)
 }
 
 /// Exact [`insphere`] on a lattice (see above), `None` when the differences do not fit.
@@ -1045,6 +1058,47 @@ mod tests {
         assert!(insphere_lattice(DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z, x).is_none());
         let big = DVec3::new(1e16, 0.0, 0.0);
         assert!(orient3d_lattice(DVec3::ZERO, DVec3::X, DVec3::Y, big + DVec3::Z * 0.5).is_none());
+    }
+
+    /// The lattice path's fine lattice (zeros only) agrees with robust: exactly coplanar
+    /// points off the 40-bit lattice are zero with robust's value bit for bit; points nudged
+    /// one ulp off the plane and random points are left to robust.
+    #[test]
+    fn fine_lattice_orient_zeros_agree_with_robust() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(17);
+        let (mut zeros, mut nonzeros) = (0, 0);
+        for it in 0..20_000 {
+            let scale = [1.0, 2f64.powi(-20), 2f64.powi(30)][it % 3];
+            // Integers of 48 bits times 2^-48 (beyond the 40-bit lattice path), d = b + c - a:
+            // exactly coplanar, and the sums are exact.
+            let mut g = || {
+                let mut q = || (rng.gen_range(1u64 << 46..1u64 << 47) as f64) * 2f64.powi(-47);
+                DVec3::new(q(), q(), q()) * scale
+            };
+            let (a, b, c) = (g(), g(), g());
+            let mut d = b + c - a;
+            if it % 4 == 3 {
+                d.z = f64::from_bits(d.z.to_bits() + 1);
+            }
+            let o = robust_orient(a, b, c, d);
+            match orient3d_lattice(a, b, c, d) {
+                Some(v) => {
+                    assert_eq!(o, 0.0, "{a} {b} {c} {d}");
+                    assert_eq!(v.to_bits(), o.to_bits(), "{a} {b} {c} {d}");
+                    zeros += 1;
+                }
+                None => {
+                    nonzeros += usize::from(o != 0.0);
+                }
+            }
+            assert_eq!(orient3d(a, b, c, d).to_bits(), o.to_bits());
+            let e = DVec3::new(rng.gen(), rng.gen(), rng.gen()) * scale;
+            if orient3d_lattice(a, b, c, e).is_some() {
+                assert_eq!(robust_orient(a, b, c, e), 0.0);
+            }
+        }
+        assert!(zeros > 10_000 && nonzeros > 3_000, "{zeros} {nonzeros}");
     }
 
     /// The fixed-point path agrees with robust on points on a sphere (nearly cospherical),
