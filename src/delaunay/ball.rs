@@ -86,7 +86,9 @@ impl Delaunay {
         let mut index: FxHashMap<u32, u32> =
             FxHashMap::with_capacity_and_hasher(256, Default::default());
         index.insert(start, 0);
-        let mut tets = vec![first];
+        // Typical sizes (fandisk: ~120 tets, cavities of ~30 tets and ~50 faces).
+        let mut tets = Vec::with_capacity(128);
+        tets.push(first);
         let mut k = 0;
         while k < tets.len() {
             for i in 0..4 {
@@ -128,8 +130,8 @@ impl Delaunay {
         Some(BallRegion {
             mark: vec![0; tets.len()],
             tets,
-            queue: Vec::new(),
-            faces: Vec::new(),
+            queue: Vec::with_capacity(64),
+            faces: Vec::with_capacity(64),
             generation: self.generation,
         })
     }

@@ -322,7 +322,8 @@ impl Delaunay {
 
     /// All alive tets incident to vertex `v` (hull tets included).
     pub fn vertex_star(&self, v: u32) -> Vec<u32> {
-        let mut star = vec![];
+        // A vertex of a quality mesh has about 20-30 tets around it.
+        let mut star = Vec::with_capacity(32);
         self.search_star(v, &mut star, |_| false);
         star
     }

@@ -89,6 +89,9 @@ type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
 /// coordinates, planarity, simple polygons, holes) and triangulates it. Surface-level checks
 /// (closure, facet intersections) need [`super::validate`]. `triangle_cells` is left empty.
 pub fn build_facet(k: usize, facet: &Facet, vertices: &[DVec3]) -> Result<PlcFacet, PlcError> {
+    if let Some(triangle) = lone_triangle(k, facet, vertices)? {
+        return Ok(triangle);
+    }
     if facet.polygons.is_empty() {
         return Err(PlcError::EmptyFacet { facet: k });
     }
@@ -129,6 +132,29 @@ pub fn build_facet(k: usize, facet: &Facet, vertices: &[DVec3]) -> Result<PlcFac
         return Ok(triangle);
     }
     triangulate(k, facet, &polygons, &lone, vertices)
+}
+
+/// [`build_facet`] for a facet that is one triangle and nothing else, without the general
+/// path's lists (the checks and the result are the same): None when the facet is anything
+/// else or [`single_triangle`] leaves it to the general path.
+fn lone_triangle(
+    k: usize,
+    facet: &Facet,
+    vertices: &[DVec3],
+) -> Result<Option<PlcFacet>, PlcError> {
+    let [p] = facet.polygons.as_slice() else {
+        return Ok(None);
+    };
+    if p.len() != 3 || !facet.hole_polygons.is_empty() || !facet.hole_points.is_empty() {
+        return Ok(None);
+    }
+    let r = PolygonRef {
+        facet: k,
+        kind: PolygonKind::Outer,
+        index: 0,
+    };
+    check_polygon(r, p, vertices.len())?;
+    single_triangle(k, facet, &[(r, p.as_slice())], &[], vertices)
 }
 
 /// The general path of [`build_facet`], after the per-polygon checks: the plane, the
@@ -358,7 +384,17 @@ fn check_polygon(r: PolygonRef, p: &[u32], num_vertices: usize) -> Result<(), Pl
             count: p.len(),
         });
     }
-    let mut sorted = p.to_vec();
+    // Short polygons (nearly all) are sorted on the stack.
+    let mut short = [0u32; 16];
+    let mut long;
+    let sorted: &mut [u32] = if p.len() <= short.len() {
+        let s = &mut short[..p.len()];
+        s.copy_from_slice(p);
+        s
+    } else {
+        long = p.to_vec();
+        &mut long
+    };
     sorted.sort_unstable();
     if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
         return Err(PlcError::RepeatedVertex {
