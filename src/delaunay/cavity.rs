@@ -73,10 +73,6 @@ pub struct BoundaryFace {
 }
 
 impl BoundaryFace {
-    pub(super) fn new(v: [u32; 3], outer: u32, owner: u32) -> BoundaryFace {
-        BoundaryFace { v, outer, owner }
-    }
-
     /// The face's vertices, positively oriented with the new point: the tet `(a, b, c, p)` is
     /// the one inserting p creates on it (a face holding `INFINITE` makes a hull tet).
     #[inline]
@@ -233,16 +229,6 @@ impl Delaunay {
                 .find_cavity(p, self.points.len() as u32, start, watch)
                 .then(|| self.probed(p, hint)),
         }
-    }
-
-    /// What a probe of `p` from `hint` would leave behind without its search: the walk's
-    /// random choices are made, and the buffers hold no current cavity (a kept one is
-    /// inserted as after a probe of another point). A caller that skips a probe whose result
-    /// it knows keeps everything after it the same.
-    pub fn skip_probe(&mut self, p: DVec3, hint: Option<u32>) {
-        let start = hint.filter(|&t| self.is_alive(t)).unwrap_or(self.last);
-        self.locate(p, start);
-        self.scratch.probed = None;
     }
 
     /// Locates `p` from `hint` for a probe: the tet the search starts from, or the vertex at p.

@@ -12,7 +12,6 @@
 //! slots go to a free list. Limits: fewer than 2^30 tets and 2^32 - 2 vertices; coordinates as
 //! accepted by `geom::check_coordinate`.
 
-mod ball;
 mod cavity;
 pub mod hilbert;
 mod locate;
@@ -20,7 +19,6 @@ pub mod tables;
 mod validate;
 
 use crate::geom::{self, orient3d};
-pub use ball::BallRegion;
 pub use cavity::{BoundaryFace, Cavity, CavityWatch, DryRun, Probe};
 use glam::DVec3;
 use tables::FACE;

@@ -17,7 +17,7 @@
 
 use super::outcome::{Outcome, Refusal};
 use super::MeshError;
-use crate::delaunay::{BallRegion, BoundaryFace, Cavity, CavityWatch, Delaunay, Probe, INFINITE};
+use crate::delaunay::{BoundaryFace, Cavity, CavityWatch, Delaunay, Probe, INFINITE};
 use crate::geom::circumsphere;
 use crate::geom::screen::{shortest_edge_sq, sliver_measures, SliverScreen};
 use glam::DVec3;
@@ -74,16 +74,6 @@ pub(crate) trait FacetLevel {
         }
     }
 
-    /// The region of a picking ball for estimated cavities ([`Delaunay::ball_region`]); a
-    /// level that keeps its tets' circumspheres lends them.
-    fn ball_region(&mut self, start: u32, centre: DVec3, radius: f64) -> Option<BallRegion> {
-        let dt = self.triangulation();
-        dt.ball_region(start, centre, radius, |t| {
-            let [a, b, c, d] = dt.tet_points(t);
-            circumsphere(a, b, c, d)
-        })
-    }
-
     /// Refines encroached element `e` (from its own refinement point, with `picker` where
     /// the level chooses by small slivers) or queues it at its level; the levels below work
     /// off what that queued before the cell is looked at again.
@@ -109,9 +99,6 @@ pub(crate) struct Picker {
     screen: SliverScreen,
     /// When to stop drawing before `max_tries` (None: never).
     give_up: Option<GiveUp>,
-    /// Whether random draws are scored on estimated cavities first ([`BallRegion`]), and
-    /// probed exactly only when the estimate beats the best candidate.
-    estimates: bool,
 }
 
 /// Stop drawing once `after` draws have left the best candidate with at least `n_small`
@@ -160,11 +147,6 @@ impl Score {
     }
 }
 
-/// Random draws probed exactly before a pick scores the rest on estimated cavities: the
-/// estimates' region costs about as much as a few probes, and most picks end within a few
-/// draws.
-const ESTIMATE_AFTER: usize = 1;
-
 /// A probed candidate point and its score.
 pub(crate) struct Candidate {
     pub score: Score,
@@ -188,17 +170,6 @@ impl Picker {
             slivers: SliverBounds::new(sigma0, min_dihedral_deg),
             screen: SliverScreen::new(sigma0, min_dihedral_deg),
             give_up: None,
-            estimates: false,
-        }
-    }
-
-    /// The picker, scoring its random draws on estimated cavities first: the same choices
-    /// (but for near-cospherical draws), with one exact cavity search per draw that beats the
-    /// best instead of one per draw.
-    pub fn estimating(self) -> Picker {
-        Picker {
-            estimates: true,
-            ..self
         }
     }
 
@@ -354,31 +325,11 @@ pub(crate) fn pick_in_ball<F: FacetLevel + ?Sized>(
         best = Some(Candidate { score, cavity });
     }
     if best.as_ref().is_none_or(|b| b.score.n_small > 0) {
-        // Built once a pick has needed ESTIMATE_AFTER draws (None: not estimating, or the
-        // ball has no region).
-        let mut region: Option<Option<BallRegion>> = None;
         for draws in 0..picker.max_tries {
             if picker.gives_up(draws, best.as_ref().map(|b: &Candidate| &b.score)) {
                 break;
             }
             let p = picker.in_ball(centre, r);
-            if let Some(b) = best
-                .as_ref()
-                .filter(|_| picker.estimates && draws >= ESTIMATE_AFTER)
-            {
-                let region =
-                    region.get_or_insert_with(|| level.ball_region(hint, centre, picker.delta * r));
-                if let Some(region) = region {
-                    let mut count = picker.sliver_count(p, r, Some(b.score));
-                    let dt = level.triangulation();
-                    if !dt.estimate_cavity_watched(region, p, &mut count)
-                        || !count.score.better_than(&b.score)
-                    {
-                        dt.skip_probe(p, Some(hint));
-                        continue;
-                    }
-                }
-            }
             if try_candidate(level, picker, p, r, Some(hint), true, &mut best) {
                 break;
             }

@@ -8,11 +8,10 @@
 
 use super::{key3, Bad, Loc, Restricted, SurfaceMesher};
 use crate::delaunay::tables::FACE;
-use crate::delaunay::{BallRegion, Cavity, Delaunay, INFINITE};
+use crate::delaunay::{Cavity, Delaunay, INFINITE};
 use crate::refine::levels::{Conflict, FacetLevel, Picker, Request};
 use crate::refine::outcome::{BoundaryKind, Outcome};
 use crate::refine::MeshError;
-use glam::DVec3;
 
 /// What a cell's point would break.
 #[derive(Debug)]
@@ -29,12 +28,6 @@ impl FacetLevel for SurfaceMesher<'_> {
 
     fn triangulation(&mut self) -> &mut Delaunay {
         &mut self.dt
-    }
-
-    /// With the circumspheres tracking keeps.
-    fn ball_region(&mut self, start: u32, centre: DVec3, radius: f64) -> Option<BallRegion> {
-        self.dt
-            .ball_region(start, centre, radius, |t| self.sphere_of(t))
     }
 
     /// What inserting probed point p would break: a restricted facet whose surface ball holds

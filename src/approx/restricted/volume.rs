@@ -98,8 +98,7 @@ impl SurfaceMesher<'_> {
                     crit.sigma0,
                     crit.min_dihedral_deg,
                 )
-                .giving_up(APPROX_GIVE_UP)
-                .estimating(),
+                .giving_up(APPROX_GIVE_UP),
             ),
             queues: Default::default(),
             deferrals: FxHashMap::default(),

@@ -160,17 +160,6 @@ fn flat_by_construction_names_collinear_and_coplanar_tets() {
     assert!(!dom.flat_by_construction([0, m, x, off_f]));
 }
 
-/// The unit cube refined to constant spacing `h` with the default parameters.
-fn cube_refined_to(h: f64) -> (Domain, Params) {
-    let (mut dom, regions) = settled_cube();
-    let params = Params::default();
-    let spacing = super::super::ConstantSpacing(h);
-    Refiner::new(&mut dom, &params, &spacing, &regions)
-        .run(&mut |_| true)
-        .unwrap();
-    (dom, params)
-}
-
 /// Keep mode's facet level, through the interface the cell level uses, on the unit cube
 /// refined to spacing 0.3: a point well inside breaks nothing; a point just above the middle
 /// of the bottom facet encroaches a subfacet there, and the policy decides by the request and
@@ -179,7 +168,12 @@ fn cube_refined_to(h: f64) -> (Domain, Params) {
 #[test]
 fn plc_facet_level_conflicts_follow_the_request() {
     use super::super::levels::pick_in_ball;
-    let (mut dom, params) = cube_refined_to(0.3);
+    let (mut dom, regions) = settled_cube();
+    let params = Params::default();
+    let spacing = super::super::ConstantSpacing(0.3);
+    Refiner::new(&mut dom, &params, &spacing, &regions)
+        .run(&mut |_| true)
+        .unwrap();
     dom.check().unwrap();
     let probe = |dom: &mut Domain, p: DVec3| match dom.dt.probe(p, None) {
         Probe::Cavity(c) => c,
@@ -243,47 +237,6 @@ fn plc_facet_level_conflicts_follow_the_request() {
     let chosen = chosen.expect("a point that breaks nothing");
     assert!(chosen.point().distance(inside) <= params.delta * 0.2);
     assert!(dom.encroached(&chosen).is_none());
-}
-
-/// Scoring random draws on estimated cavities first chooses what probing every draw chooses:
-/// the same point from the same picking balls (keep mode's facet level on the refined cube,
-/// balls of 200 tets inside it, with the strict sliver bounds that make most picks draw
-/// many times).
-#[test]
-fn estimating_pickers_choose_as_probing_ones() {
-    use super::super::levels::pick_in_ball;
-    let (mut dom, params) = cube_refined_to(0.3);
-    let picker = |seed: u64| {
-        let rng = rand::SeedableRng::seed_from_u64(seed);
-        Picker::new(rng, params.delta, 20, params.b, 0.3, 35.0)
-    };
-    let tets: Vec<u32> = dom.dt.finite_tet_ids().collect();
-    let (mut picks, mut draws_beyond_centre) = (0, 0);
-    for (k, &t) in tets.iter().enumerate().step_by(tets.len() / 200) {
-        let [a, b, c, d] = dom.dt.tet_points(t);
-        let Some((centre, r)) = crate::geom::circumsphere(a, b, c, d) else {
-            continue;
-        };
-        if !(centre.min_element() > 0.1 && centre.max_element() < 0.9) {
-            continue;
-        }
-        let mut chosen = Vec::new();
-        for mut picker in [picker(k as u64), picker(k as u64).estimating()] {
-            let Probe::Cavity(cavity) = dom.dt.probe(centre, Some(t)) else {
-                continue;
-            };
-            let pick = pick_in_ball(&mut dom, &mut picker, centre, Some(cavity), r, t);
-            chosen.push((pick.map(|c| c.point()), picker.rng.clone()));
-        }
-        assert_eq!(chosen[0].0, chosen[1].0, "tet {t}");
-        assert!(chosen[0].1 == chosen[1].1, "tet {t}: as many draws");
-        picks += 1;
-        draws_beyond_centre += usize::from(chosen[0].0 != Some(centre));
-    }
-    assert!(
-        picks > 100 && draws_beyond_centre > 50,
-        "{picks} / {draws_beyond_centre}"
-    );
 }
 
 /// The boundary complex's invariants (`Domain::check`) hold after boundary recovery and after
