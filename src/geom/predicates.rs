@@ -1070,7 +1070,7 @@ mod tests {
         let (mut zeros, mut nonzeros) = (0, 0);
         for it in 0..20_000 {
             let scale = [1.0, 2f64.powi(-20), 2f64.powi(30)][it % 3];
-            // Integers of 48 bits times 2^-48 (beyond the 40-bit lattice path), d = b + c - a:
+            // 47-bit integers times 2^-47 (beyond the 40-bit lattice path), d = b + c - a:
             // exactly coplanar, and the sums are exact.
             let mut g = || {
                 let mut q = || (rng.gen_range(1u64 << 46..1u64 << 47) as f64) * 2f64.powi(-47);
