@@ -4,6 +4,7 @@
 pub mod measures;
 pub mod predicates;
 pub mod screen;
+mod wide;
 
 pub use measures::*;
 pub use predicates::*;

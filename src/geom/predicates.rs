@@ -55,6 +55,7 @@
 //! determinant is exactly zero. The bounds are re-derived by a test (`filter_bounds_derivation`)
 //! and the filters are checked against robust on near-degenerate inputs.
 
+use super::wide::{W3, W5};
 use glam::DVec3;
 use std::cmp::Ordering;
 
@@ -425,129 +426,6 @@ fn pow2(e: i32) -> f64 {
     f64::from_bits(((e + 1023) as u64) << 52)
 }
 
-/// Magnitude and sign of an i128.
-#[inline(always)]
-fn split_i128(x: i128) -> (bool, u128) {
-    (x < 0, x.unsigned_abs())
-}
-
-/// A 3-word (192-bit) two's-complement integer, little-endian words.
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct W3([u64; 3]);
-
-/// A 5-word (320-bit) two's-complement integer, little-endian words.
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct W5([u64; 5]);
-
-macro_rules! wide_ops {
-    ($t:ident, $n:expr) => {
-        impl $t {
-            #[inline]
-            fn add(self, o: Self) -> Self {
-                let mut r = [0u64; $n];
-                let mut carry = false;
-                for i in 0..$n {
-                    let (s1, c1) = self.0[i].overflowing_add(o.0[i]);
-                    let (s2, c2) = s1.overflowing_add(carry as u64);
-                    r[i] = s2;
-                    carry = c1 | c2;
-                }
-                $t(r)
-            }
-            #[inline]
-            fn neg(self) -> Self {
-                let mut r = [0u64; $n];
-                let mut carry = true;
-                for i in 0..$n {
-                    let (s, c) = (!self.0[i]).overflowing_add(carry as u64);
-                    r[i] = s;
-                    carry = c;
-                }
-                $t(r)
-            }
-            #[inline]
-            fn sub(self, o: Self) -> Self {
-                self.add(o.neg())
-            }
-            /// Two's complement of the product of a magnitude (`words` little-endian) and
-            /// a sign.
-            #[inline]
-            fn from_mag(neg: bool, words: [u64; $n]) -> Self {
-                let r = $t(words);
-                if neg {
-                    r.neg()
-                } else {
-                    r
-                }
-            }
-        }
-    };
-}
-wide_ops!(W3, 3);
-wide_ops!(W5, 5);
-
-impl W3 {
-    /// Exact `a·b` (|a| < 2^63, |b| < 2^127: the product fits in 190 bits).
-    #[inline]
-    fn mul(a: i64, b: i128) -> W3 {
-        let (na, ma) = (a < 0, a.unsigned_abs() as u128);
-        let (nb, mb) = split_i128(b);
-        let lo = ma * (mb as u64 as u128);
-        let hi = ma * (mb >> 64);
-        // lo + (hi << 64)
-        let w0 = lo as u64;
-        let (mid, c) = ((lo >> 64) as u64).overflowing_add(hi as u64);
-        let w2 = (hi >> 64) as u64 + c as u64;
-        W3::from_mag(na != nb, [w0, mid, w2])
-    }
-}
-
-impl W5 {
-    /// Exact `a·b` (|a| < 2^127, |b| < 2^191 as a two's-complement W3).
-    #[inline]
-    fn mul(a: i128, b: W3) -> W5 {
-        let (na, ma) = split_i128(a);
-        let nb = (b.0[2] as i64) < 0;
-        let mb = if nb { b.neg() } else { b }.0;
-        let a_words = [ma as u64, (ma >> 64) as u64];
-        let mut r = [0u64; 5];
-        for (i, &x) in a_words.iter().enumerate() {
-            let mut carry = 0u128;
-            for (j, &y) in mb.iter().enumerate() {
-                let t = x as u128 * y as u128 + r[i + j] as u128 + carry;
-                r[i + j] = t as u64;
-                carry = t >> 64;
-            }
-            let mut k = i + 3;
-            while carry != 0 && k < 5 {
-                let t = r[k] as u128 + carry;
-                r[k] = t as u64;
-                carry = t >> 64;
-                k += 1;
-            }
-        }
-        W5::from_mag(na != nb, r)
-    }
-
-    /// The sign (-1, 0, 1) and the value rounded to a double (a few ulps).
-    fn sign_and_approx(self) -> (i32, f64) {
-        let neg = (self.0[4] as i64) < 0;
-        let m = if neg { self.neg() } else { self }.0;
-        if m.iter().all(|&w| w == 0) {
-            return (0, 0.0);
-        }
-        let mut v = 0.0;
-        for &w in m.iter().rev() {
-            v = v * 18446744073709551616.0 + w as f64;
-        }
-        if neg {
-            (-1, -v)
-        } else {
-            (1, v)
-        }
-    }
-}
-
 /// Exact [`orient3d`] on a lattice (see above), `None` when the differences do not fit. On
 /// a finer lattice (|k| < 2^62: exactly coplanar points off a coarse lattice, as in the planar
 /// regions of a CAD surface whose triangle pairs validation tests) only an exact zero is
@@ -581,7 +459,7 @@ fn orient3d_lattice(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Option<f64> {
         .add(W3::mul(cdz as i64, m(adx, bdy, bdx, ady)));
     // What robust gives for an exact zero (its full evaluation), negated as in
     // `orient3d_exact`.
-    (det.0 == [0; 3]).then_some(-0.0)
+    det.is_zero().then_some(-0.0)
 }
 
 /// Exact [`insphere`] on a lattice (see above), `None` when the differences do not fit.
@@ -1153,12 +1031,6 @@ mod tests {
             }
         }
         assert!(decided > 40_000 && zeros > 500, "{decided} {zeros}");
-        // wide arithmetic corner cases
-        let big = (1i128 << 126) - 1;
-        let w = W3::mul(-(1i64 << 62), big);
-        let back = W5::mul(-big, w);
-        assert!(back.sign_and_approx().0 > 0);
-        assert_eq!(W3::mul(0, big).sign_and_approx_w3(), 0);
     }
 
     #[test]
@@ -1196,18 +1068,6 @@ mod tests {
             assert!(insphere(a, b, c, d, DVec3::splat(0.25 * s)) > 0.0, "2^{k}");
             assert!(insphere(a, b, c, d, DVec3::splat(2.0 * s)) < 0.0, "2^{k}");
             assert_eq!(insphere(a, b, c, d, DVec3::splat(s)), 0.0, "2^{k}");
-        }
-    }
-
-    impl W3 {
-        fn sign_and_approx_w3(self) -> i32 {
-            if self.0 == [0; 3] {
-                0
-            } else if (self.0[2] as i64) < 0 {
-                -1
-            } else {
-                1
-            }
         }
     }
 
