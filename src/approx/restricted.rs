@@ -21,6 +21,8 @@
 
 mod facet_level;
 mod tracking;
+#[cfg(test)]
+pub(super) use tracking::CHECK_EVERY_INSERTION;
 mod volume;
 
 pub use volume::VolumeCriteria;
@@ -620,6 +622,9 @@ impl<'a> SurfaceMesher<'a> {
     /// crossed when the face appeared; crossing it again from the other end could move the
     /// centre by a rounding error).
     fn facet_at(&self, t: u32, i: usize) -> Option<Restricted> {
+        if !self.track.is_restricted(t, i) {
+            return None;
+        }
         let face = FACE[i].map(|k| self.dt.tet(t)[k]);
         let &(centre, radius, triangle) = self.track.restricted.get(&key3(face))?;
         Some(Restricted {

@@ -174,6 +174,19 @@ fn fandisk_meets_the_distance_and_angle_bounds() {
     );
 }
 
+/// The restricted facets each tet records (`tracking::TetInfo`) agree with the map of them
+/// after every insertion, at both levels, on models with features, thin parts and curved
+/// patches (`assert_restricted_bits` panics at the first disagreement).
+#[test]
+fn restricted_bits_follow_every_insertion() {
+    use super::restricted::CHECK_EVERY_INSERTION;
+    CHECK_EVERY_INSERTION.set(true);
+    for name in ["off/cross.off", "off/star.off", "off/spool.off"] {
+        check_mesh(name, None);
+    }
+    CHECK_EVERY_INSERTION.set(false);
+}
+
 /// Same input, parameters and seed: the same mesh.
 #[test]
 fn approximate_mode_is_deterministic() {

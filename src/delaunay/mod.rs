@@ -255,6 +255,12 @@ impl Delaunay {
     pub fn neighbors(&self, t: u32) -> [u32; 4] {
         self.tets[t as usize].n.map(|r| r >> 2)
     }
+
+    /// The tet across face `i` of tet `t`, and the index the shared face has in it.
+    pub fn mirror(&self, t: u32, i: usize) -> (u32, usize) {
+        let r = self.tets[t as usize].n[i];
+        (r >> 2, (r & 3) as usize)
+    }
     /// Corner coordinates of finite tet `t`.
     pub fn tet_points(&self, t: u32) -> [DVec3; 4] {
         self.tets[t as usize].v.map(|v| self.points[v as usize])

@@ -44,7 +44,10 @@ impl FacetLevel for SurfaceMesher<'_> {
             if n_surface < 3 {
                 continue;
             }
-            for f in FACE {
+            for (i, f) in FACE.iter().enumerate() {
+                if !self.track.is_restricted(t, i) {
+                    continue;
+                }
                 let face = f.map(|k| tv[k]);
                 if !face.iter().all(|&v| on_surface(v)) {
                     continue;

@@ -38,6 +38,24 @@ pub(super) struct Tracking {
     pub restricted: FxHashMap<[u32; 3], SurfaceBall>,
 }
 
+impl Tracking {
+    /// Whether face `i` of live tet `t` is a restricted facet (a key of `restricted`).
+    pub fn is_restricted(&self, t: u32, i: usize) -> bool {
+        self.tets
+            .get(t as usize)
+            .is_some_and(|info| info.restricted & (1 << i) != 0)
+    }
+
+    /// Records whether face `i` of tet `t` is restricted, on `t` and on the tet across it.
+    fn mark_face(&mut self, dt: &Delaunay, t: u32, i: usize, restricted: bool) {
+        let (n, j) = dt.mirror(t, i);
+        for (tet, face) in [(t, i), (n, j)] {
+            let bits = &mut self.tets[tet as usize].restricted;
+            *bits = (*bits & !(1 << face)) | (u8::from(restricted) << face);
+        }
+    }
+}
+
 /// What is tracked of one tet, side by side: each insertion reads it for the tets around its
 /// cavity, and the cell level for the tets it looks at.
 #[derive(Debug, Clone, Copy)]
@@ -47,6 +65,10 @@ pub(super) struct TetInfo {
     radius: f64,
     /// The circumcentre lies inside the surface (false without one).
     inside: bool,
+    /// Bit i: face i (opposite vertex i) is a key of [`Tracking::restricted`]. Kept exact on
+    /// both tets of each face, so that the faces of removed and probed tets that are not
+    /// restricted (nearly all) are not looked up in the map.
+    restricted: u8,
 }
 
 impl Default for TetInfo {
@@ -55,6 +77,7 @@ impl Default for TetInfo {
             centre: DVec3::ZERO,
             radius: -1.0,
             inside: false,
+            restricted: 0,
         }
     }
 }
@@ -72,6 +95,7 @@ impl TetInfo {
                 centre,
                 radius,
                 inside: false,
+                restricted: 0,
             },
             None => TetInfo::default(),
         }
@@ -102,6 +126,10 @@ impl SurfaceMesher<'_> {
         };
         for r in classified.restricted {
             self.queue_if_bad(r);
+        }
+        #[cfg(test)]
+        if CHECK_EVERY_INSERTION.get() {
+            self.assert_restricted_bits();
         }
     }
 
@@ -167,15 +195,30 @@ impl SurfaceMesher<'_> {
         {
             for &t in created {
                 track.tets[t as usize].inside = inside;
+                // The restricted facets are unchanged: only a face across the cavity's
+                // boundary can be one, and the tet outside still records it.
+                let i = self.dt.tet(t).iter().position(|&v| v == new_vertex);
+                if let Some(i) = i {
+                    let (n, j) = self.dt.mirror(t, i);
+                    let outside = track.is_restricted(n, j);
+                    track.mark_face(&self.dt, t, i, outside);
+                }
             }
             self.track = track;
+            #[cfg(test)]
+            if CHECK_EVERY_INSERTION.get() {
+                self.assert_restricted_bits();
+            }
             return;
         }
         // A facet found again with the same surface centre, ball and input triangle was judged
         // already (its criteria depend on nothing else): it is not judged again.
         let mut before = vec![];
-        for tv in self.dt.last_removed() {
-            for f in FACE {
+        for (tv, info) in self.dt.last_removed().iter().zip(&removed) {
+            for (i, f) in FACE.iter().enumerate() {
+                if info.restricted & (1 << i) == 0 {
+                    continue;
+                }
                 let key = key3(f.map(|k| tv[k]));
                 if let Some(old) = track.restricted.remove(&key) {
                     before.push((key, old));
@@ -201,6 +244,7 @@ impl SurfaceMesher<'_> {
                     // The new Voronoi edge is the part of the old one outside the new vertex's
                     // cell: the old one crossed nothing, so neither does it (even parity).
                     track.tets[t as usize].inside = other.inside;
+                    track.mark_face(&self.dt, t, i, false);
                     continue;
                 }
                 let (crossings, parity) = match (c, other.centre()) {
@@ -210,7 +254,9 @@ impl SurfaceMesher<'_> {
                 if outer {
                     track.tets[t as usize].inside = self.side_across(other.inside, c, parity);
                 }
-                if let Some(r) = Self::facet_from(&self.dt, face, crossings) {
+                let restricted = Self::facet_from(&self.dt, face, crossings);
+                track.mark_face(&self.dt, t, i, restricted.is_some());
+                if let Some(r) = restricted {
                     let key = key3(r.vertices);
                     let ball = (r.centre, r.radius, r.triangle);
                     track.restricted.insert(key, ball);
@@ -223,6 +269,10 @@ impl SurfaceMesher<'_> {
         self.track = track;
         for r in found {
             self.queue_if_bad(r);
+        }
+        #[cfg(test)]
+        if CHECK_EVERY_INSERTION.get() {
+            self.assert_restricted_bits();
         }
     }
 
@@ -307,9 +357,49 @@ impl SurfaceMesher<'_> {
                 let face = FACE[i].map(|k| tv[k]);
                 if let Some(r) = Self::facet_from(&self.dt, face, crossings) {
                     out.restricted.push(r);
+                    let (n, j) = self.dt.mirror(t, i);
+                    out.tets[t as usize].restricted |= 1 << i;
+                    out.tets[n as usize].restricted |= 1 << j;
                 }
             }
         }
         out
+    }
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Test switch: check the restricted bits after every insertion on this thread.
+    pub(in crate::approx) static CHECK_EVERY_INSERTION: std::cell::Cell<bool> =
+        const { std::cell::Cell::new(false) };
+}
+
+#[cfg(test)]
+impl SurfaceMesher<'_> {
+    /// Every live tet's restricted bits agree with the map, and every key of the map is a
+    /// face of two live tets (none left behind by a removal).
+    pub(super) fn assert_restricted_bits(&self) {
+        let mut marked = 0;
+        for t in 0..self.dt.tet_capacity() as u32 {
+            if !self.dt.is_alive(t) {
+                continue;
+            }
+            let tv = self.dt.tet(t);
+            for (i, f) in FACE.iter().enumerate() {
+                let key = key3(f.map(|k| tv[k]));
+                let in_map = self.track.restricted.contains_key(&key);
+                assert_eq!(
+                    self.track.is_restricted(t, i),
+                    in_map,
+                    "tet {t} face {i} {key:?}: bit and map disagree"
+                );
+                marked += usize::from(in_map);
+            }
+        }
+        assert_eq!(
+            marked,
+            2 * self.track.restricted.len(),
+            "stale restricted facets"
+        );
     }
 }
