@@ -117,9 +117,10 @@ fn feature_distance(r: &Remeshed, positions: &[DVec3]) -> f64 {
     worst
 }
 
-/// Of the tets with a vertex within twice the protecting radius of a small corner (its
-/// influence): how many miss the refinement's radius-edge or dihedral bound; and the largest
-/// radius-edge ratio of all the other tets.
+/// Of the tets with a vertex in a small corner's protecting ball (its influence: the ball the
+/// surface mesher leaves alone and the report's completeness excludes): how many miss the
+/// refinement's radius-edge or dihedral bound; and the largest radius-edge ratio of all the
+/// other tets.
 pub fn small_corner_figures(
     mesh: &TetMesh,
     corners: &[(DVec3, f64)],
@@ -133,7 +134,7 @@ pub fn small_corner_figures(
         let near = p.iter().any(|q| {
             corners
                 .iter()
-                .any(|(c, r)| (*q - *c).length_squared() < 4.0 * r * r)
+                .any(|(c, r)| (*q - *c).length_squared() <= r * r)
         });
         if !near {
             max_rho_away = max_rho_away.max(rho);
@@ -240,6 +241,48 @@ impl SegmentGrid {
 mod tests {
     use super::*;
     use rand::{Rng, SeedableRng};
+
+    /// The small-corner figures split the tets at the protecting ball, as the report's
+    /// completeness does: a bad tet just outside the ball is away from the corner (its rho is
+    /// the largest away), one with a vertex on the ball's sphere is near it.
+    #[test]
+    fn small_corner_figures_split_at_the_protecting_ball() {
+        // A needle (rho far above 2) and a regular tet.
+        let needle = [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(0.5, 0.5, 0.01),
+        ];
+        let regular = [
+            DVec3::new(10.0, 0.0, 0.0),
+            DVec3::new(11.0, 0.0, 0.0),
+            DVec3::new(10.5, 0.75f64.sqrt(), 0.0),
+            DVec3::new(10.5, 0.75f64.sqrt() / 3.0, (2.0f64 / 3.0).sqrt()),
+        ];
+        let vertices: Vec<DVec3> = needle.iter().chain(&regular).copied().collect();
+        let mesh = TetMesh {
+            vertices,
+            tets: vec![[0, 1, 2, 3], [4, 5, 6, 7]],
+            ..TetMesh::default()
+        };
+        let params = Params::default();
+        let rho_needle = radius_edge_ratio(needle[0], needle[1], needle[2], needle[3]);
+        let rho_regular = radius_edge_ratio(regular[0], regular[1], regular[2], regular[3]);
+        assert!(rho_needle > 2.0 && rho_regular < 1.0);
+        // The corner 1.5 protecting radii from the needle's nearest vertex: away.
+        let corner = [(DVec3::new(-1.5, 0.0, 0.0), 1.0)];
+        assert_eq!(
+            small_corner_figures(&mesh, &corner, &params),
+            (0, rho_needle)
+        );
+        // Its vertex on the ball's sphere: near, and bad.
+        let corner = [(DVec3::new(-1.0, 0.0, 0.0), 1.0)];
+        assert_eq!(
+            small_corner_figures(&mesh, &corner, &params),
+            (1, rho_regular)
+        );
+    }
 
     /// The grid's nearest distance is the brute-force minimum, bit for bit, for points near
     /// the segments and far from them.

@@ -320,10 +320,11 @@ pub struct SurfaceReport {
     pub n_corners: usize,
     pub n_patches: usize,
     /// Feature corners whose angle (between feature curves, or spanned by a patch) is below
-    /// 60 degrees, and the output tets within their influence that miss a bound.
+    /// 60 degrees, and the output tets with a vertex in their protecting balls that miss a
+    /// bound.
     pub n_small_corners: usize,
     pub n_bad_near_small_corners: usize,
-    /// The largest radius-edge ratio of the tets outside every small corner's influence.
+    /// The largest radius-edge ratio of the other tets (the ones `complete` is judged on).
     pub max_rho_away_from_small_corners: f64,
     /// Vertices and triangles of the remeshed boundary.
     pub n_surface_vertices: usize,
