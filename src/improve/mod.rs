@@ -32,6 +32,7 @@ mod topo;
 use crate::geom::{orient3d, TetQuality};
 use crate::mesh::TetMesh;
 use crate::plc::PlcInput;
+use crate::refine::report::Shapes;
 use crate::refine::{MeshError, Report};
 use constraints::Constraint;
 use glam::DVec3;
@@ -415,36 +416,12 @@ pub fn check_no_degenerate(mesh: &TetMesh) -> Result<(), MeshError> {
 /// Re-measures the shape figures of `report` (counts, rho, sigma, dihedral angles, tets below
 /// 5/10/15/20 degrees) on `mesh`; size figures stay those of the refinement.
 pub fn update_report(report: &mut Report, mesh: &TetMesh) {
-    let mut used = vec![false; mesh.vertices.len()];
-    mesh.tets
-        .iter()
-        .flatten()
-        .for_each(|&v| used[v as usize] = true);
-    report.n_vertices = used.iter().filter(|&&u| u).count();
-    report.n_tets = mesh.tets.len();
-    report.n_boundary_faces = mesh.boundary.len();
-    report.max_rho = 0.0;
-    report.min_sigma = f64::INFINITY;
-    report.min_dihedral_deg = 180.0;
-    report.max_dihedral_deg = 0.0;
-    report.tets_below_deg = [0; 4];
+    let mut shapes = Shapes::new();
     for t in &mesh.tets {
         let p = t.map(|v| mesh.vertices[v as usize]);
-        let q = TetQuality::of(p[0], p[1], p[2], p[3]);
-        report.max_rho = report.max_rho.max(q.rho);
-        report.min_sigma = report.min_sigma.min(q.sigma);
-        report.min_dihedral_deg = report.min_dihedral_deg.min(q.min_dihedral);
-        report.max_dihedral_deg = report.max_dihedral_deg.max(q.max_dihedral);
-        for (k, limit) in [5.0, 10.0, 15.0, 20.0].iter().enumerate() {
-            if q.min_dihedral < *limit {
-                report.tets_below_deg[k] += 1;
-            }
-        }
+        shapes.add(&TetQuality::of(p[0], p[1], p[2], p[3]));
     }
-    if mesh.tets.is_empty() {
-        report.min_sigma = 0.0;
-        report.min_dihedral_deg = 0.0;
-    }
+    shapes.write(mesh, report);
 }
 
 /// Measures an improved mesh into the report (all of its figures, not only the shapes that

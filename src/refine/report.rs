@@ -4,6 +4,62 @@ use super::{MeshError, Params, Report, Spacing};
 use crate::geom::TetQuality;
 use crate::mesh::TetMesh;
 
+/// A mesh's counts and shape figures (rho, sigma, dihedral extremes, tets below 5/10/15/20
+/// degrees), accumulated tet by tet: the refinement's report and the improvement's re-measure
+/// ([`crate::improve::update_report`]) take them the same way.
+pub(crate) struct Shapes {
+    max_rho: f64,
+    min_sigma: f64,
+    min_dihedral: f64,
+    max_dihedral: f64,
+    below: [usize; 4],
+}
+
+impl Shapes {
+    pub fn new() -> Shapes {
+        Shapes {
+            max_rho: 0.0,
+            min_sigma: f64::INFINITY,
+            min_dihedral: 180.0,
+            max_dihedral: 0.0,
+            below: [0; 4],
+        }
+    }
+
+    pub fn add(&mut self, q: &TetQuality) {
+        self.max_rho = self.max_rho.max(q.rho);
+        self.min_sigma = self.min_sigma.min(q.sigma);
+        self.min_dihedral = self.min_dihedral.min(q.min_dihedral);
+        self.max_dihedral = self.max_dihedral.max(q.max_dihedral);
+        for (k, limit) in [5.0, 10.0, 15.0, 20.0].iter().enumerate() {
+            if q.min_dihedral < *limit {
+                self.below[k] += 1;
+            }
+        }
+    }
+
+    /// Writes the figures, and `mesh`'s counts, into `r` (an empty mesh: sigma and the
+    /// smallest dihedral angle 0).
+    pub fn write(&self, mesh: &TetMesh, r: &mut Report) {
+        let mut used = vec![false; mesh.vertices.len()];
+        mesh.tets
+            .iter()
+            .flatten()
+            .for_each(|&v| used[v as usize] = true);
+        r.n_vertices = used.iter().filter(|&&u| u).count();
+        r.n_tets = mesh.tets.len();
+        r.n_boundary_faces = mesh.boundary.len();
+        r.max_rho = self.max_rho;
+        r.max_dihedral_deg = self.max_dihedral;
+        r.tets_below_deg = self.below;
+        (r.min_sigma, r.min_dihedral_deg) = if mesh.tets.is_empty() {
+            (0.0, 0.0)
+        } else {
+            (self.min_sigma, self.min_dihedral)
+        };
+    }
+}
+
 /// Measures `mesh` (tets only; timings and completion are filled in by the caller). Tets that
 /// miss a bound of `params` are counted in `n_bad_near_acute` when `near_small_angle(tet)` says so;
 /// the others are returned.
@@ -14,38 +70,17 @@ pub fn measure(
     near_small_angle: &dyn Fn(&[u32; 4]) -> bool,
 ) -> Result<(Report, usize), MeshError> {
     let mut bad_elsewhere = 0;
-    let mut r = Report {
-        n_vertices: {
-            let mut used = vec![false; mesh.vertices.len()];
-            mesh.tets
-                .iter()
-                .flatten()
-                .for_each(|&v| used[v as usize] = true);
-            used.iter().filter(|&&u| u).count()
-        },
-        n_tets: mesh.tets.len(),
-        n_boundary_faces: mesh.boundary.len(),
-        min_sigma: f64::INFINITY,
-        min_dihedral_deg: 180.0,
-        ..Default::default()
-    };
+    let mut r = Report::default();
+    let mut shapes = Shapes::new();
     let p = |v: u32| mesh.vertices[v as usize];
     for t in &mesh.tets {
         let q = TetQuality::of(p(t[0]), p(t[1]), p(t[2]), p(t[3]));
-        r.max_rho = r.max_rho.max(q.rho);
-        r.min_sigma = r.min_sigma.min(q.sigma);
-        r.min_dihedral_deg = r.min_dihedral_deg.min(q.min_dihedral);
-        r.max_dihedral_deg = r.max_dihedral_deg.max(q.max_dihedral);
+        shapes.add(&q);
         if q.rho > params.rho0 || q.sigma < params.sigma0 || q.min_dihedral < params.min_dihedral {
             if near_small_angle(t) {
                 r.n_bad_near_acute += 1;
             } else {
                 bad_elsewhere += 1;
-            }
-        }
-        for (k, limit) in [5.0, 10.0, 15.0, 20.0].iter().enumerate() {
-            if q.min_dihedral < *limit {
-                r.tets_below_deg[k] += 1;
             }
         }
         if let Some(c) = q.circumcenter {
@@ -67,10 +102,7 @@ pub fn measure(
         r.edge_ratio_min = below.iter().copied().fold(*median, f64::min);
         r.edge_ratio_max = above.iter().copied().fold(*median, f64::max);
     }
-    if mesh.tets.is_empty() {
-        r.min_sigma = 0.0;
-        r.min_dihedral_deg = 0.0;
-    }
+    shapes.write(mesh, &mut r);
     Ok((r, bad_elsewhere))
 }
 
