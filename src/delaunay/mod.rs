@@ -261,6 +261,7 @@ impl Delaunay {
         let r = self.tets[t as usize].n[i];
         (r >> 2, (r & 3) as usize)
     }
+
     /// Corner coordinates of finite tet `t`.
     pub fn tet_points(&self, t: u32) -> [DVec3; 4] {
         self.tets[t as usize].v.map(|v| self.points[v as usize])
@@ -406,8 +407,7 @@ impl Delaunay {
         let i = (0..4)
             .find(|&i| v[i] != a && v[i] != b && v[i] != c)
             .unwrap();
-        let r = self.tets[t as usize].n[i];
-        Some([(t, i), (r >> 2, (r & 3) as usize)])
+        Some([(t, i), self.mirror(t, i)])
     }
 
     /// Renames internal vertex `i` to `order[i]` and restores the caller's point order.
