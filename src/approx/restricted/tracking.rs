@@ -27,6 +27,11 @@ fn was_restricted(before: &[([u32; 3], SurfaceBall)], face: [u32; 3]) -> bool {
     before.iter().any(|(k, _)| *k == key)
 }
 
+/// The face of created tet `t` across the cavity's boundary: the one opposite the new vertex.
+fn outer_face(dt: &Delaunay, t: u32, new_vertex: u32) -> Option<usize> {
+    dt.tet(t).iter().position(|&v| v == new_vertex)
+}
+
 /// Relative margin of [`SurfaceMesher::surface_untouched`]'s distance test.
 const UNTOUCHED_MARGIN: f64 = 1e-6;
 
@@ -197,11 +202,11 @@ impl SurfaceMesher<'_> {
                 track.tets[t as usize].inside = inside;
                 // The restricted facets are unchanged: only a face across the cavity's
                 // boundary can be one, and the tet outside still records it.
-                let i = self.dt.tet(t).iter().position(|&v| v == new_vertex);
-                if let Some(i) = i {
+                if let Some(i) = outer_face(&self.dt, t, new_vertex) {
                     let (n, j) = self.dt.mirror(t, i);
-                    let outside = track.is_restricted(n, j);
-                    track.mark_face(&self.dt, t, i, outside);
+                    if track.is_restricted(n, j) {
+                        track.tets[t as usize].restricted |= 1 << i;
+                    }
                 }
             }
             self.track = track;
@@ -230,8 +235,8 @@ impl SurfaceMesher<'_> {
         // (fandisk 1-2% less CPU time). `black_box` only keeps the reads; nothing depends on it.
         let mut across = 0u8;
         for &t in created {
-            if let Some(i) = self.dt.tet(t).iter().position(|&v| v == new_vertex) {
-                across ^= track.tets[self.dt.neighbors(t)[i] as usize].restricted;
+            if let Some(i) = outer_face(&self.dt, t, new_vertex) {
+                across ^= track.tets[self.dt.mirror(t, i).0 as usize].restricted;
             }
         }
         std::hint::black_box(across);
