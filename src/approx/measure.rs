@@ -67,6 +67,8 @@ pub fn surface_report(r: &Remeshed, mesh: &TetMesh) -> SurfaceReport {
         },
         n_feature_edges: r.features.edges.len(),
         n_feature_polylines: r.features.polylines.len(),
+        n_noise_edges: r.noise.edges,
+        n_noise_curves: r.noise.curves,
         n_corners: r.n_corners,
         n_patches: r.features.n_patches,
         n_small_corners: r.small_corners.len(),

@@ -60,6 +60,8 @@ pub struct Remeshed {
     /// The oracle of `surface`.
     pub oracle: SurfaceOracle,
     pub features: Features,
+    /// The creases left out as noise.
+    pub noise: crate::surface::features::Noise,
     pub boundary: PlcInput,
     /// Feature edges of the new boundary (vertex pairs of `boundary.vertices`).
     pub feature_edges: Vec<[u32; 2]>,
@@ -294,29 +296,32 @@ pub fn remesh(
     let plc = crate::plc::validate(input).map_err(|e| MeshError::InvalidInput(e.to_string()))?;
     check_one_volume(&plc)?;
     let surface = InputSurface::from_plc(&plc);
-    let features = Features::detect(
+    let diagonal = surface.bbox_diagonal();
+    let default_spacing = ConstantSpacing(DEFAULT_SPACING_FRACTION * diagonal);
+    let f: &dyn Spacing = spacing.unwrap_or(&default_spacing);
+    // A bad spacing value keeps every crease here; the surface mesher reports it.
+    let (features, noise) = Features::detect_denoised(
         &surface,
         &FeatureParams {
             feature_angle: params.feature_angle,
             use_markers: has_labels(input),
         },
+        &mut |p| f.at(p),
     );
     let mut curves = FeatureCurves::new(&surface, &features);
-    let diagonal = surface.bbox_diagonal();
     let distance = if params.surface_distance > 0.0 {
         params.surface_distance
     } else {
         DEFAULT_SURFACE_DISTANCE_FRACTION * diagonal
     };
     curves.cap_protect_radius(PROTECT_DISTANCES * distance);
-    let default_spacing = ConstantSpacing(DEFAULT_SPACING_FRACTION * diagonal);
-    let f: &dyn Spacing = spacing.unwrap_or(&default_spacing);
     let oracle = SurfaceOracle::new(&surface);
     let criteria = SurfaceCriteria {
         distance: DISTANCE_SAFETY * distance,
         bound: distance,
         min_angle_deg: FACET_MIN_ANGLE_DEG,
         max_vertices: params.max_vertices,
+        feature_floor: PROTECT_DISTANCES * distance,
         seed: params.seed,
     };
     let mesher = SurfaceMesher::new(&surface, &oracle, &curves, &features.patch_of, f, criteria)?;
@@ -343,6 +348,7 @@ pub fn remesh(
         surface,
         oracle,
         features,
+        noise,
         boundary,
         feature_edges: b.feature_edges,
         distance,

@@ -57,6 +57,10 @@ pub struct SurfaceCriteria {
     pub min_angle_deg: f64,
     /// Stop (with a reason) past this many vertices.
     pub max_vertices: usize,
+    /// Facets with a smaller surface ball are refined only for the distance bound: features
+    /// closer together than this (two creases meeting at a tiny angle, a sliver patch between
+    /// them) are not resolved, as inside a small corner's protecting ball.
+    pub feature_floor: f64,
     /// Seed of the random surface samples.
     pub seed: u64,
 }
@@ -165,8 +169,6 @@ pub struct SurfaceMesher<'a> {
     facets: BinaryHeap<Queued>,
     /// Subsegments too short to split further (their ends would coincide in floating point).
     frozen: FxHashSet<[u32; 2]>,
-    /// Vertices the surface mesh may reach (`SAMPLE_BUDGET_FACTOR` x the initial samples).
-    budget: usize,
     /// How often each facet waited for subsegment splits (see `MAX_DEFERRALS`).
     deferrals: FxHashMap<[u32; 3], u32>,
     bad_spacing: Option<MeshError>,
@@ -180,11 +182,6 @@ pub struct SurfaceMesher<'a> {
     /// The input's Hausdorff samples (`measure::hausdorff_samples`), once taken.
     input_samples: std::cell::OnceCell<Vec<DVec3>>,
 }
-
-/// The surface mesh stops (with a reason) at this many times its initial samples: the
-/// criteria are met with a few times more in every model measured, and a facet that cannot be
-/// shaped (a configuration the criteria cannot resolve) must not refine without end.
-const SAMPLE_BUDGET_FACTOR: usize = 20;
 
 /// Rounds of subsegment splits one facet may wait for before it is left alone.
 const MAX_DEFERRALS: u32 = 8;
@@ -254,7 +251,6 @@ impl<'a> SurfaceMesher<'a> {
             force_split: FxHashSet::default(),
             facets: BinaryHeap::new(),
             frozen: FxHashSet::default(),
-            budget: usize::MAX,
             deferrals: FxHashMap::default(),
             bad_spacing: None,
             min_length: 1e-9 * diagonal,
@@ -284,7 +280,6 @@ impl<'a> SurfaceMesher<'a> {
         let (dt, _) = Delaunay::from_points(&points)
             .map_err(|e| MeshError::InvalidInput(format!("surface samples: {e}")))?;
         m.dt = dt;
-        m.budget = SAMPLE_BUDGET_FACTOR * points.len() + 10_000;
         m.seg_queue = {
             let mut keys: Vec<[u32; 2]> = m.subsegs.keys().copied().collect();
             keys.sort_unstable();
@@ -435,59 +430,85 @@ impl<'a> SurfaceMesher<'a> {
 
     /// Runs `refine` and extracts the boundary, fixing what breaks it, until it is a closed
     /// 2-manifold of surface vertices (and, before the cell level, within the distance bound
-    /// of every input sample).
+    /// of every input sample): CGAL's manifold criterion, driven to the end. Each round must
+    /// insert a point, so the loop ends, at the latest at `max_vertices`.
     fn rounds(
         &mut self,
         refine: &mut dyn FnMut(&mut Self) -> Option<String>,
     ) -> Result<(Vec<FaceRef>, Option<String>), MeshError> {
-        let mut stop_reason = None;
-        for _round in 0..16 {
-            stop_reason = refine(self);
+        loop {
+            let stop_reason = refine(self);
             if let Some(e) = self.bad_spacing.take() {
                 return Err(e);
             }
-            if stop_reason.is_some() {
-                break;
+            let (faces, problems) = self.extract();
+            let far = if problems.is_empty() && self.vol.is_none() && stop_reason.is_none() {
+                self.far_from_input(&faces)
+            } else {
+                vec![]
+            };
+            if problems.is_empty() && far.is_empty() {
+                return Ok((faces, stop_reason));
             }
-            let (faces, mut problems) = self.extract();
-            if problems.is_empty() && self.vol.is_none() {
-                problems = self.far_from_input(&faces);
+            let not_closed = |n: usize, why: &str| {
+                MeshError::InvalidInput(format!(
+                    "surface mode approximate: the remeshed boundary is not a closed manifold \
+                     ({n} faces in the way; {why})"
+                ))
+            };
+            if let Some(reason) = stop_reason {
+                return Err(not_closed(problems.len(), &reason));
             }
-            if problems.is_empty() {
-                return Ok((faces, None));
-            }
-            for (t, i) in problems {
+            // Faces by their vertices: an insertion may remove the tets that held the next.
+            let face_of = |m: &Self, (t, i): FaceRef| FACE[i].map(|k| m.dt.tet(t)[k]);
+            let mut mend: Vec<([u32; 3], Option<DVec3>)> =
+                problems.iter().map(|&f| (face_of(self, f), None)).collect();
+            mend.extend(
+                far.iter()
+                    .map(|&(t, i, p)| (face_of(self, (t, i)), Some(p))),
+            );
+            let before = self.dt.num_vertex_ids();
+            for (face, sample) in mend {
+                let Some([(t, i), _]) = self.dt.find_face(face[0], face[1], face[2]) else {
+                    continue;
+                };
                 if let Some(r) = self.facet_at(t, i) {
                     self.insert_surface_point(r, t, Bad::Boundary);
+                } else if let Some(c) = self
+                    .oracle
+                    .closest(sample.unwrap_or_else(|| centroid(&self.dt, face)))
+                {
+                    self.insert_input_point(c.point, c.triangle, face, t);
                 }
             }
+            if self.dt.num_vertex_ids() == before {
+                return Err(not_closed(
+                    problems.len(),
+                    "no point of the input could be inserted to mend them",
+                ));
+            }
         }
-        let (faces, problems) = self.extract();
-        if problems.is_empty() {
-            return Ok((faces, stop_reason));
-        }
-        Err(MeshError::InvalidInput(format!(
-            "surface mode approximate: the remeshed boundary is not a closed manifold \
-             ({} faces in the way{}); try a smaller spacing or --surface keep",
-            problems.len(),
-            stop_reason.map(|r| format!("; {r}")).unwrap_or_default()
-        )))
+    }
+
+    /// Inserts a point of the input surface (on input triangle `triangle`) to mend boundary
+    /// face `face`, which is not a restricted facet, as if it were that facet's centre.
+    fn insert_input_point(&mut self, p: DVec3, triangle: u32, face: [u32; 3], hint: u32) {
+        let r = Restricted {
+            vertices: face,
+            centre: p,
+            radius: 0.0,
+            triangle,
+        };
+        self.insert_surface_point(r, hint, Bad::Boundary);
     }
 
     /// The refinement loop: subsegments first, then the largest bad facet.
     fn refine(&mut self) -> Option<String> {
         loop {
-            let budget = if self.vol.is_some() {
-                self.criteria.max_vertices
-            } else {
-                self.criteria.max_vertices.min(self.budget)
-            };
-            if self.dt.num_vertices() > budget {
+            if self.dt.num_vertices() > self.criteria.max_vertices {
                 return Some(format!(
-                    "the surface mesh reached {} vertices ({} from the samples, or \
-                     max_vertices): facets that refinement cannot shape",
-                    self.dt.num_vertices(),
-                    SAMPLE_BUDGET_FACTOR
+                    "the mesh reached max_vertices = {} vertices while refining the surface",
+                    self.criteria.max_vertices
                 ));
             }
             if self.bad_spacing.is_some() {
@@ -673,14 +694,15 @@ impl<'a> SurfaceMesher<'a> {
     /// small corner).
     fn badness(&mut self, r: &Restricted) -> Bad {
         let patch = self.patch_of[r.triangle as usize];
-        if !r.vertices.iter().all(|&v| self.on_patch(v, patch)) {
+        let above_floor = r.radius >= self.criteria.feature_floor;
+        if above_floor && !r.vertices.iter().all(|&v| self.on_patch(v, patch)) {
             return Bad::Topology;
         }
         if r.radius > self.f(r.centre) {
             return Bad::Size;
         }
         let [a, b, c] = r.vertices.map(|v| self.dt.point(v));
-        let protected = [a, b, c].iter().any(|&p| self.near_small_corner(p));
+        let protected = !above_floor || [a, b, c].iter().any(|&p| self.near_small_corner(p));
         if !protected && has_angle_below(a, b, c, self.criteria.min_angle_deg) {
             return Bad::Angle;
         }
@@ -813,7 +835,8 @@ impl<'a> SurfaceMesher<'a> {
 
     /// The faces between tets whose circumcentres are inside and outside the surface (as
     /// (inside tet, face index)), and those of them that break the boundary: a vertex off the
-    /// surface, or an edge not shared by exactly two faces.
+    /// surface, an edge not shared by exactly two faces, or a vertex whose faces do not make
+    /// one disk (two sheets touching at a point, as across a thin part).
     fn extract(&self) -> (Vec<FaceRef>, Vec<FaceRef>) {
         let mut inside = vec![false; self.dt.tet_capacity()];
         for t in self.dt.finite_tet_ids() {
@@ -838,6 +861,11 @@ impl<'a> SurfaceMesher<'a> {
                 *edge_count.entry(key2(f[j], f[(j + 1) % 3])).or_default() += 1;
             }
         }
+        let pinched = pinched_vertices(
+            faces
+                .iter()
+                .map(|&(t, i)| FACE[i].map(|k| self.dt.tet(t)[k])),
+        );
         let problems = faces
             .iter()
             .copied()
@@ -845,7 +873,9 @@ impl<'a> SurfaceMesher<'a> {
                 let tv = self.dt.tet(t);
                 let f = FACE[i].map(|k| tv[k]);
                 f.iter().any(|&v| {
-                    v == INFINITE || matches!(self.loc[v as usize], Loc::Far | Loc::Volume)
+                    v == INFINITE
+                        || matches!(self.loc[v as usize], Loc::Far | Loc::Volume)
+                        || pinched.contains(&v)
                 }) || (0..3).any(|j| edge_count[&key2(f[j], f[(j + 1) % 3])] != 2)
             })
             .collect();
@@ -855,7 +885,7 @@ impl<'a> SurfaceMesher<'a> {
     /// The boundary faces nearest to the samples of the input the report's Hausdorff
     /// distance takes (`measure::hausdorff_samples`) that lie farther than the bound from
     /// them, away from small corners, where the surface is left coarse on purpose.
-    fn far_from_input(&self, faces: &[FaceRef]) -> Vec<FaceRef> {
+    fn far_from_input(&self, faces: &[FaceRef]) -> Vec<(u32, usize, DVec3)> {
         let triangles = faces
             .iter()
             .map(|&(t, i)| FACE[i].map(|k| self.dt.tet(t)[k]))
@@ -867,7 +897,7 @@ impl<'a> SurfaceMesher<'a> {
             .get_or_init(|| super::measure::hausdorff_samples(self.surface));
         // Consecutive samples come from one input triangle: the last face found is tried first.
         let mut hint = None;
-        let mut far: Vec<FaceRef> = points
+        let mut far: Vec<(FaceRef, f64, DVec3)> = points
             .iter()
             .copied()
             .filter(|&p| {
@@ -875,11 +905,21 @@ impl<'a> SurfaceMesher<'a> {
                     .is_some()
             })
             .filter(|&p| !self.near_small_corner(p))
-            .filter_map(|p| near.closest(p).map(|c| faces[c.triangle as usize]))
+            .filter_map(|p| {
+                near.closest(p)
+                    .map(|c| (faces[c.triangle as usize], c.distance, p))
+            })
             .collect();
-        far.sort_unstable();
-        far.dedup();
-        far
+        // One sample per face: the farthest (ties by position, for determinism).
+        far.sort_unstable_by(|a, b| {
+            a.0.cmp(&b.0).then(b.1.total_cmp(&a.1)).then(
+                a.2.to_array()
+                    .partial_cmp(&b.2.to_array())
+                    .unwrap_or(Ordering::Equal),
+            )
+        });
+        far.dedup_by_key(|x| x.0);
+        far.into_iter().map(|((t, i), _, p)| (t, i, p)).collect()
     }
 
     /// The boundary from the extracted faces, oriented outwards, vertices renumbered.
@@ -979,6 +1019,36 @@ impl SurfaceMesher<'_> {
             ..VolumeMesh::default()
         })
     }
+}
+
+/// The vertices of `faces` whose faces around them do not form one fan: the edges opposite
+/// them (their link) make more than one connected piece.
+fn pinched_vertices(faces: impl Iterator<Item = [u32; 3]>) -> FxHashSet<u32> {
+    let mut link: FxHashMap<u32, Vec<[u32; 2]>> = FxHashMap::default();
+    for f in faces {
+        for j in 0..3 {
+            link.entry(f[j])
+                .or_default()
+                .push([f[(j + 1) % 3], f[(j + 2) % 3]]);
+        }
+    }
+    link.into_iter()
+        .filter(|(_, edges)| link_pieces(edges) > 1)
+        .map(|(v, _)| v)
+        .collect()
+}
+
+/// Connected pieces of a small graph given by its edges.
+fn link_pieces(edges: &[[u32; 2]]) -> usize {
+    let mut ids: Vec<u32> = edges.iter().flatten().copied().collect();
+    ids.sort_unstable();
+    ids.dedup();
+    let local = |v: u32| ids.binary_search(&v).unwrap_or(0) as u32;
+    let mut sets = crate::union_find::UnionFind::new(ids.len());
+    for e in edges {
+        sets.union(local(e[0]), local(e[1]));
+    }
+    (0..ids.len() as u32).filter(|&x| sets.find(x) == x).count()
 }
 
 fn centroid(dt: &Delaunay, f: [u32; 3]) -> DVec3 {

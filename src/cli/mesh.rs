@@ -270,6 +270,10 @@ fn surface_table(s: &SurfaceReport) -> String {
         format!("{} / {}", s.n_feature_edges, s.n_feature_polylines),
     );
     row(
+        "noise edges / curves",
+        format!("{} / {}", s.n_noise_edges, s.n_noise_curves),
+    );
+    row(
         "corners / patches",
         format!("{} / {}", s.n_corners, s.n_patches),
     );

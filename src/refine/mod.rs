@@ -317,6 +317,10 @@ pub struct SurfaceReport {
     /// Sharp edges, feature polylines, corners and smooth patches found in the input.
     pub n_feature_edges: usize,
     pub n_feature_polylines: usize,
+    /// Crease edges and curves left out as noise (short, free-hanging or isolated creases of
+    /// a scan: `surface::features`).
+    pub n_noise_edges: usize,
+    pub n_noise_curves: usize,
     pub n_corners: usize,
     pub n_patches: usize,
     /// Feature corners whose angle (between feature curves, or spanned by a patch) is below

@@ -1,6 +1,8 @@
 //! Helpers shared by the integration tests: model paths and mesh invariant checkers.
 #![allow(dead_code)]
 
+pub mod corpus;
+
 use slivermesh::geom::{insphere, orient3d};
 use slivermesh::mesh::TetMesh;
 use slivermesh::plc::PlcInput;

@@ -135,6 +135,7 @@ mod tests {
             bound: 1e-3,
             min_angle_deg: 30.0,
             max_vertices: 100_000,
+            feature_floor: 0.0,
             seed: 1,
         };
         let mut m = SurfaceMesher::new(
