@@ -57,23 +57,24 @@ from meshcompare import (Failure, check_executable, keep_surface, match_count,  
 
 
 def off_volume(path):
-    """Volume enclosed by an OFF polyhedron (fan-triangulated faces, divergence theorem)."""
+    """Volume enclosed by an OFF polyhedron (fan-triangulated faces, divergence theorem). COFF
+    and NOFF files carry colours or normals after a vertex's coordinates: one vertex a line,
+    its first three numbers."""
     with open(path) as f:
-        words = [w for line in f for w in line.split("#", 1)[0].split()]
+        lines = [ln.split("#", 1)[0].split() for ln in f]
+    lines = [ln for ln in lines if ln]
     try:
-        if words[0] != "OFF":
+        header = lines[0]
+        if not header[0].endswith("OFF"):
             raise ValueError("no OFF header")
-        nv, nf = int(words[1]), int(words[2])
-        pos = 4
-        pts = []
-        for _ in range(nv):
-            pts.append(tuple(float(w) for w in words[pos:pos + 3]))
-            pos += 3
+        counts = header[1:] if len(header) > 1 else lines[1]
+        body = lines[1:] if len(header) > 1 else lines[2:]
+        nv, nf = int(counts[0]), int(counts[1])
+        pts = [tuple(float(w) for w in ln[:3]) for ln in body[:nv]]
         six_v = 0.0
-        for _ in range(nf):
-            k = int(words[pos])
-            ids = [int(w) for w in words[pos + 1:pos + 1 + k]]
-            pos += 1 + k
+        for ln in body[nv:nv + nf]:
+            k = int(ln[0])
+            ids = [int(w) for w in ln[1:1 + k]]
             a = pts[ids[0]]
             for i in range(1, k - 1):
                 b, c = pts[ids[i]], pts[ids[i + 1]]
