@@ -29,6 +29,7 @@ use crate::refine::{
 };
 use crate::surface::features::{FeatureParams, Features};
 use crate::surface::oracle::SurfaceOracle;
+use crate::surface::thickness::Thickness;
 use crate::surface::InputSurface;
 use curves::FeatureCurves;
 use restricted::{SurfaceCriteria, SurfaceMesher, VolumeCriteria, VolumeMesh};
@@ -46,6 +47,39 @@ const DISTANCE_SAFETY: f64 = 0.5;
 /// Largest protecting-ball radius of a small corner, in distance bounds: the surface is not
 /// refined inside the ball, so the boundary stays within about this of the input there.
 const PROTECT_DISTANCES: f64 = 2.0;
+
+/// The surface spacing is at most this many times the local thickness radius (half the
+/// thickness of a thin part, half the gap between two parts: `surface::thickness`).
+const THICKNESS_SPACING: f64 = 1.0;
+
+/// Largest thickness radius estimated, as a share of the bounding-box diagonal (thicker
+/// parts never bound the spacing).
+const THICKNESS_CAP: f64 = 0.25;
+
+/// The caller's (or the default) spacing, bounded on the surface by its local thickness.
+struct ThinSpacing<'a> {
+    f: &'a dyn Spacing,
+    /// The thickness never asks for a spacing below this (the feature floor: a rim whose
+    /// radius tends to zero would be refined without end).
+    floor: f64,
+    thickness: &'a Thickness,
+    surface: &'a InputSurface,
+    oracle: &'a SurfaceOracle,
+}
+
+impl Spacing for ThinSpacing<'_> {
+    fn at(&self, p: glam::DVec3) -> f64 {
+        let h = self.f.at(p);
+        let t =
+            (THICKNESS_SPACING * self.thickness.at(self.surface, self.oracle, p)).max(self.floor);
+        // A value that is not a number stays the caller's, for its error.
+        if t < h {
+            t
+        } else {
+            h
+        }
+    }
+}
 
 /// Smallest angle of a boundary triangle, degrees (CGAL's facet_angle; 30 guarantees
 /// termination in Boissonnat & Oudot's analysis).
@@ -316,6 +350,15 @@ pub fn remesh(
     };
     curves.cap_protect_radius(PROTECT_DISTANCES * distance);
     let oracle = SurfaceOracle::new(&surface);
+    let thickness = Thickness::estimate(&surface, &oracle, THICKNESS_CAP * diagonal);
+    let thin = ThinSpacing {
+        f,
+        floor: PROTECT_DISTANCES * distance,
+        thickness: &thickness,
+        surface: &surface,
+        oracle: &oracle,
+    };
+    let f: &dyn Spacing = &thin;
     let criteria = SurfaceCriteria {
         distance: DISTANCE_SAFETY * distance,
         bound: distance,

@@ -20,7 +20,8 @@
 //! a few degrees leave a sliver of patch between them). A crease curve (between corners, made
 //! of dihedral edges only) shorter than [`NOISE_SPACINGS`] local spacings is dropped when
 //! - it is weak: its mean normal deviation is below [`WEAK_CREASE`] times the feature angle
-//!   (a scan's folds: 40-60 degrees at the default 40; CAD creases: mostly 75 and more), or
+//!   (a scan's folds: 40-60 degrees at the default 40; CAD creases: mostly 75 and more) and
+//!   below [`WEAK_CONTRAST`] times that of the non-feature edges at its vertices, or
 //!   it does not stand out from the surface around it (mean deviation below
 //!   [`CREASE_CONTRAST`] times that of the non-feature edges at its vertices);
 //! - it hangs free (an end on no other feature edge), is a closed loop, or belongs to a
@@ -198,6 +199,10 @@ pub const CREASE_CONTRAST: f64 = 2.0;
 /// for 519 of them.
 pub const WEAK_CREASE: f64 = 1.5;
 
+/// A weak crease is noise only among bending edges: below this contrast with them (a crease
+/// between flat facets, as a low-poly spike's, is kept however shallow).
+pub const WEAK_CONTRAST: f64 = 4.0;
+
 /// A noise curve is shorter than this many local spacings (at 1 or 2, dino and triceratops
 /// keep enough short creases between small corners to end at 6-18 degrees).
 pub const NOISE_SPACINGS: f64 = 3.0;
@@ -374,9 +379,10 @@ impl Bending {
             / (vertices.len() - 1) as f64
     }
 
-    /// Whether the curve through `vertices` bends less than [`CREASE_CONTRAST`] times the
-    /// edges at its vertices that are not in `features`, on average.
-    fn blends_in(&self, vertices: &[u32], features: &[[u32; 2]]) -> bool {
+    /// How many times more the curve through `vertices` bends than the edges at its vertices
+    /// that are not in `features`, on average (infinite where there are none, or they are
+    /// flat: a crease between planar facets).
+    fn contrast(&self, vertices: &[u32], features: &[[u32; 2]]) -> f64 {
         let along = self.mean_along(vertices);
         let (mut sum, mut n) = (0.0, 0usize);
         for &v in vertices {
@@ -387,7 +393,11 @@ impl Bending {
                 }
             }
         }
-        n > 0 && along < CREASE_CONTRAST * sum / n as f64
+        if n == 0 || sum == 0.0 {
+            f64::INFINITY
+        } else {
+            along / (sum / n as f64)
+        }
     }
 }
 
@@ -431,7 +441,8 @@ fn noise_curves(
         {
             continue;
         }
-        if bending.blends_in(&vertices, edges) {
+        let contrast = bending.contrast(&vertices, edges);
+        if contrast < CREASE_CONTRAST {
             out.push(vertices);
             continue;
         }
@@ -444,7 +455,8 @@ fn noise_curves(
         }
         let ends = [vertices[0], vertices[vertices.len() - 1]];
         let small_cluster = cluster_length[&cluster.find(ends[0])] < h;
-        let weak = bending.mean_along(&vertices) < WEAK_CREASE * p.feature_angle;
+        let weak = bending.mean_along(&vertices) < WEAK_CREASE * p.feature_angle
+            && contrast < WEAK_CONTRAST;
         if weak || line.closed || ends.iter().any(|&v| free(v)) || small_cluster {
             out.push(vertices);
         }

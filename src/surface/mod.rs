@@ -8,6 +8,8 @@
 //! - [`oracle`]: an AABB tree over the triangles: closest point, segment crossings (the exact
 //!   segment/triangle test decides, floating point only places the crossing), inside test by
 //!   ray parity with exact predicates.
+//! - [`thickness`]: the radius of the largest empty ball touching the surface at each vertex,
+//!   inside or outside (half the local thickness, or half the gap to another part).
 //! - [`distance`]: two-sided Hausdorff distance between two triangle surfaces, by dense
 //!   sampling.
 
@@ -16,6 +18,7 @@ pub mod features;
 pub mod oracle;
 #[cfg(test)]
 mod tests;
+pub mod thickness;
 
 use crate::plc::Plc;
 use glam::DVec3;
