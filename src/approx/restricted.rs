@@ -34,6 +34,7 @@ use crate::geom::tri_circumcenter;
 use crate::refine::outcome::{BoundaryKind, Outcome, Refusal};
 use crate::refine::{MeshError, Spacing};
 use crate::surface::oracle::{Crossing, SurfaceOracle};
+use crate::surface::thickness::Thickness;
 use crate::surface::InputSurface;
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
@@ -61,6 +62,9 @@ pub struct SurfaceCriteria {
     /// closer together than this (two creases meeting at a tiny angle, a sliver patch between
     /// them) are not resolved, as inside a small corner's protecting ball.
     pub feature_floor: f64,
+    /// With a thickness (`SurfaceMesher::new`), the surface spacing is at most this many
+    /// times the input's thickness radius, never below `feature_floor`.
+    pub thickness_spacing: f64,
     /// Seed of the random surface samples.
     pub seed: u64,
 }
@@ -181,6 +185,22 @@ pub struct SurfaceMesher<'a> {
     small_balls: Vec<(DVec3, f64)>,
     /// The input's Hausdorff samples (`measure::hausdorff_samples`), once taken.
     input_samples: std::cell::OnceCell<Vec<DVec3>>,
+    /// The thickness bound of the surface spacing, if a thickness was given.
+    thin: Option<ThinBound>,
+}
+
+/// The surface spacing's bound by the input's thickness, per input triangle.
+struct ThinBound {
+    /// Thickness radius of each input triangle (its corners' smallest).
+    per_triangle: Vec<f64>,
+    scale: f64,
+    floor: f64,
+}
+
+impl ThinBound {
+    fn at(&self, triangle: u32) -> f64 {
+        (self.scale * self.per_triangle[triangle as usize]).max(self.floor)
+    }
 }
 
 /// Rounds of subsegment splits one facet may wait for before it is left alone.
@@ -234,6 +254,7 @@ impl<'a> SurfaceMesher<'a> {
         curves: &'a FeatureCurves,
         patch_of: &'a [u32],
         spacing: &'a dyn Spacing,
+        thickness: Option<&Thickness>,
         criteria: SurfaceCriteria,
     ) -> Result<SurfaceMesher<'a>, MeshError> {
         let diagonal = surface.bbox_diagonal();
@@ -257,6 +278,11 @@ impl<'a> SurfaceMesher<'a> {
             track: tracking::Tracking::default(),
             vol: None,
             input_samples: std::cell::OnceCell::new(),
+            thin: thickness.map(|t| ThinBound {
+                per_triangle: t.per_triangle(surface),
+                scale: criteria.thickness_spacing,
+                floor: criteria.feature_floor,
+            }),
             small_balls: curves
                 .small_corners()
                 .map(|c| (c.point, c.protect_radius * c.protect_radius))
@@ -290,14 +316,28 @@ impl<'a> SurfaceMesher<'a> {
         Ok(m)
     }
 
+    /// The surface spacing at `p`: the caller's, bounded by the thickness of the input
+    /// triangle nearest to `p`.
     fn f(&mut self, p: DVec3) -> f64 {
+        let triangle = match self.thin {
+            Some(_) => self.oracle.closest(p).map(|c| c.triangle),
+            None => None,
+        };
+        self.f_on(p, triangle)
+    }
+
+    /// The surface spacing at `p`, a point of input triangle `triangle`.
+    fn f_on(&mut self, p: DVec3, triangle: Option<u32>) -> f64 {
         let v = self.spacing.at(p);
         if !(v.is_finite() && v > 0.0) {
             self.bad_spacing
                 .get_or_insert(MeshError::BadSpacing { point: p, value: v });
             return f64::INFINITY;
         }
-        v
+        match (&self.thin, triangle) {
+            (Some(thin), Some(t)) => v.min(thin.at(t)),
+            _ => v,
+        }
     }
 
     /// The spacing at the surface's vertices, median (the sample grid's cell size).
@@ -373,7 +413,7 @@ impl<'a> SurfaceMesher<'a> {
         for t in 0..self.surface.triangles.len() {
             let [a, b, c] = self.surface.corners(t);
             let area = 0.5 * (b - a).cross(c - a).length();
-            let h = self.f((a + b + c) / 3.0);
+            let h = self.f_on((a + b + c) / 3.0, Some(t as u32));
             let tries = ((4.0 * area / (h * h)).ceil() as usize).clamp(1, 1 << 16);
             for _ in 0..tries {
                 let (mut u, mut v): (f64, f64) = (rng.gen(), rng.gen());
@@ -381,7 +421,7 @@ impl<'a> SurfaceMesher<'a> {
                     (u, v) = (1.0 - u, 1.0 - v);
                 }
                 let p = a + (b - a) * u + (c - a) * v;
-                let r = 0.7 * self.f(p);
+                let r = 0.7 * self.f_on(p, Some(t as u32));
                 if grid.has_within(p, r) {
                     continue;
                 }
@@ -698,7 +738,7 @@ impl<'a> SurfaceMesher<'a> {
         if above_floor && !r.vertices.iter().all(|&v| self.on_patch(v, patch)) {
             return Bad::Topology;
         }
-        if r.radius > self.f(r.centre) {
+        if r.radius > self.f_on(r.centre, Some(r.triangle)) {
             return Bad::Size;
         }
         let [a, b, c] = r.vertices.map(|v| self.dt.point(v));

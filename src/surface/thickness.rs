@@ -75,14 +75,17 @@ impl Thickness {
         Thickness { radius }
     }
 
-    /// The radius at a point of the surface: the smallest of the nearest triangle's corners.
-    pub fn at(&self, surface: &InputSurface, oracle: &SurfaceOracle, p: DVec3) -> f64 {
-        oracle.closest(p).map_or(f64::INFINITY, |c| {
-            surface.triangles[c.triangle as usize]
-                .iter()
-                .map(|&v| self.radius[v as usize])
-                .fold(f64::INFINITY, f64::min)
-        })
+    /// The radius of each triangle of `surface`: its corners' smallest.
+    pub fn per_triangle(&self, surface: &InputSurface) -> Vec<f64> {
+        surface
+            .triangles
+            .iter()
+            .map(|t| {
+                t.iter()
+                    .map(|&v| self.radius[v as usize])
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .collect()
     }
 }
 

@@ -136,6 +136,7 @@ mod tests {
             min_angle_deg: 30.0,
             max_vertices: 100_000,
             feature_floor: 0.0,
+            thickness_spacing: 1.0,
             seed: 1,
         };
         let mut m = SurfaceMesher::new(
@@ -144,6 +145,7 @@ mod tests {
             &curves,
             &features.patch_of,
             &spacing,
+            None,
             criteria,
         )
         .unwrap();
