@@ -7,19 +7,22 @@ use crate::plc::PlcInput;
 use crate::refine::{self, MeshError, Params, Progress, Report, Spacing, SurfaceMode};
 
 /// Meshes `input` in `params.surface_mode`, improves the result (`params.improve`) and checks
-/// that no tet is flat or inverted. `spacing` None = automatic.
+/// that no tet is flat or inverted; the report gets each region's figures. `spacing` None =
+/// automatic.
 pub fn mesh(
     input: &PlcInput,
     params: &Params,
     spacing: Option<&dyn Spacing>,
     progress: Option<Progress>,
 ) -> Result<(TetMesh, Report), MeshError> {
-    match params.surface_mode {
+    let (mesh, mut report) = match params.surface_mode {
         SurfaceMode::Keep => {
             let (mesh, mut report) = refine::mesh(input, params, spacing, progress)?;
             let mesh = crate::improve::finish(mesh, &mut report, Some(input), params, None)?;
-            Ok((mesh, report))
+            (mesh, report)
         }
-        SurfaceMode::Approximate => crate::approx::mesh(input, params, spacing, progress),
-    }
+        SurfaceMode::Approximate => crate::approx::mesh(input, params, spacing, progress)?,
+    };
+    report.measure_regions(&mesh);
+    Ok((mesh, report))
 }

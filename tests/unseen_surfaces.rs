@@ -1,6 +1,6 @@
 //! The approximate surface mode at its defaults on generated surfaces it was not tuned on
 //! (tests/common/corpus.rs): a noisy scanned blob, thin plates, a near contact, a thin ring,
-//! and (ignored until implemented) several bodies and regions. Each shape is written to a
+//! and several bodies and regions. Each shape is written to a
 //! file, meshed by the CLI, and the mesh file it wrote is read back and checked: positive
 //! tets (exact), the minimum dihedral angle, the volume, the boundary's topology and its
 //! two-sided Hausdorff distance to the input against the distance bound the run reports.
@@ -19,6 +19,12 @@ use std::time::Instant;
 
 /// Largest relative difference between the mesh's volume and the input's.
 const VOLUME_TOL: f64 = 5e-3;
+
+/// Largest relative difference between a region's volume and the input region's.
+const REGION_VOLUME_TOL: f64 = 1e-2;
+
+/// Largest relative difference between the interface area and the input's.
+const INTERFACE_AREA_TOL: f64 = 2e-2;
 
 /// Default floor of the smallest dihedral angle (the approximate mode's improvement target).
 const MIN_DIHEDRAL: f64 = 20.0;
@@ -107,6 +113,32 @@ fn open_faces(m: &TetMesh) -> (Vec<[u32; 3]>, usize) {
         .map(|f| f.0)
         .collect();
     (open, over)
+}
+
+/// Area of the faces between tets of two different regions, and how many of them are not
+/// among the mesh's boundary triangles.
+fn interfaces(m: &TetMesh) -> (f64, usize) {
+    let key = |mut f: [u32; 3]| {
+        f.sort_unstable();
+        f
+    };
+    let written: std::collections::HashSet<[u32; 3]> = m.boundary.iter().map(|&f| key(f)).collect();
+    let mut region_of: HashMap<[u32; 3], i32> = HashMap::new();
+    let (mut area, mut unwritten) = (0.0, 0);
+    for (t, &r) in m.tets.iter().zip(&m.tet_regions) {
+        for k in 0..4 {
+            let f = key([t[(k + 1) % 4], t[(k + 2) % 4], t[(k + 3) % 4]]);
+            match region_of.insert(f, r) {
+                Some(other) if other != r => {
+                    let [a, b, c] = f.map(|v| m.vertices[v as usize]);
+                    area += (b - a).cross(c - a).length() / 2.0;
+                    unwritten += usize::from(!written.contains(&f));
+                }
+                _ => {}
+            }
+        }
+    }
+    (area, unwritten)
 }
 
 /// Volumes of the mesh's parts: tets joined through faces they share with a tet of the same
@@ -204,6 +236,47 @@ fn mesh_and_check(shape: &Shape, min_dihedral: f64) {
         failures.push(format!(
             "parts (connected tets of one region) have volumes {parts:?}, expected {want_parts:?}"
         ));
+    }
+
+    // Regions: labelled 1, 2, ... as the shape lists its parts (file order of the solids or
+    // of the cells' outer boundaries), each within 1% of its input volume; the interfaces
+    // are faces of one tet of each region, written as boundary triangles, their area within
+    // 2% of the input's.
+    if shape.part_volumes.len() > 1 {
+        let mut by_label: HashMap<i32, f64> = HashMap::new();
+        for (t, &r) in mesh.tets.iter().zip(&mesh.tet_regions) {
+            let p = t.map(|v| mesh.vertices[v as usize]);
+            *by_label.entry(r).or_default() += orient3d(p[0], p[1], p[2], p[3]) / 6.0;
+        }
+        for (k, want) in shape.part_volumes.iter().enumerate() {
+            let got = by_label.get(&(k as i32 + 1)).copied().unwrap_or(0.0);
+            if ((got - want) / want).abs() > REGION_VOLUME_TOL {
+                failures.push(format!(
+                    "region {} has volume {got:.6}, the input's {want:.6}",
+                    k + 1
+                ));
+            }
+        }
+        if by_label.len() != shape.part_volumes.len() {
+            let mut labels: Vec<i32> = by_label.keys().copied().collect();
+            labels.sort_unstable();
+            failures.push(format!(
+                "region labels {labels:?}, expected 1..={}",
+                shape.part_volumes.len()
+            ));
+        }
+        let (area, unwritten) = interfaces(&mesh);
+        let want = shape.interface_area;
+        if (want == 0.0 && area > 0.0)
+            || (want > 0.0 && ((area - want) / want).abs() > INTERFACE_AREA_TOL)
+        {
+            failures.push(format!("interface area {area:.6}, the input's {want:.6}"));
+        }
+        if unwritten > 0 {
+            failures.push(format!(
+                "{unwritten} interface faces are not boundary triangles"
+            ));
+        }
     }
 
     // The written boundary: for one body, the open tet faces, which the boundary triangles
@@ -326,30 +399,68 @@ fn torus_thin() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Several bodies and regions (not implemented yet).
+// Several bodies and regions.
 
 #[test]
-#[ignore = "several bodies and regions: issue 36 item 2"]
 fn two_bodies() {
     mesh_and_check(&corpus::two_bodies(), MIN_DIHEDRAL);
 }
 
 #[test]
-#[ignore = "several bodies and regions: issue 36 item 2"]
 fn sphere_in_box() {
     mesh_and_check(&corpus::sphere_in_box(), MIN_DIHEDRAL);
 }
 
 #[test]
-#[ignore = "several bodies and regions: issue 36 item 2"]
 fn two_touching_blocks_stl() {
     mesh_and_check(&corpus::two_touching_blocks_stl(), MIN_DIHEDRAL);
 }
 
 #[test]
-#[ignore = "several bodies and regions: issue 36 item 2"]
 fn three_regions_edge() {
     mesh_and_check(&corpus::three_regions_edge(), MIN_DIHEDRAL);
+}
+
+/// Keep mode on the same files: the regions are labelled 1, 2, ... as in approximate mode and
+/// keep the input's volumes and interface area exactly (the facets are preserved).
+#[test]
+fn several_regions_in_keep_mode() {
+    if cfg!(debug_assertions) {
+        eprintln!("skipped in a debug build: run cargo test --release");
+        return;
+    }
+    for shape in corpus::multi_body() {
+        let dir = ScratchDir::new(&format!("keep-{}", shape.name));
+        let path = dir.0.join(shape.file_name());
+        std::fs::write(&path, shape.file_text()).unwrap();
+        let input = slivermesh::io::read_plc(&path, &Default::default()).unwrap();
+        let params = slivermesh::refine::Params {
+            surface_mode: slivermesh::refine::SurfaceMode::Keep,
+            ..Default::default()
+        };
+        let (mesh, report) = slivermesh::pipeline::mesh(&input, &params, None, None)
+            .unwrap_or_else(|e| panic!("{}: {e}", shape.name));
+        let labels: Vec<i32> = report.regions.iter().map(|r| r.attribute).collect();
+        let want: Vec<i32> = (1..=shape.part_volumes.len() as i32).collect();
+        assert_eq!(labels, want, "{}", shape.name);
+        for (r, v) in report.regions.iter().zip(&shape.part_volumes) {
+            assert!(
+                ((r.volume - v) / v).abs() < 1e-9,
+                "{}: region {} volume {} against {v}",
+                shape.name,
+                r.attribute,
+                r.volume
+            );
+        }
+        let (area, unwritten) = interfaces(&mesh);
+        let want = shape.interface_area;
+        assert!(
+            (area - want).abs() <= 1e-9 * want.max(1.0) && unwritten == 0,
+            "{}: interface area {area} against {want}, {unwritten} not written",
+            shape.name
+        );
+        assert!((report.interface_area - area).abs() <= 1e-9 * area.max(1.0));
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -22,7 +22,7 @@ mod tests;
 pub use curves::SMALL_CORNER_DEG;
 
 use crate::mesh::TetMesh;
-use crate::plc::{CellKind, Facet, PlcInput};
+use crate::plc::{Facet, PlcInput};
 use crate::refine::{
     AutoSpacing, ConstantSpacing, MeshError, Params, Progress, Report, Spacing,
     DEFAULT_SURFACE_DISTANCE_FRACTION,
@@ -79,6 +79,11 @@ pub struct Remeshed {
     pub distance: f64,
     /// Volume enclosed by the input (`Plc::volume`).
     pub input_volume: f64,
+    /// Per region (`InputSurface::sides` numbering, from 1, at index - 1): its attribute in
+    /// the output (`Plc::region_attributes`).
+    pub region_attributes: Vec<i32>,
+    /// The input's region volumes and interface area (`Plc::input_regions`).
+    pub input_regions: crate::plc::InputRegions,
     pub n_corners: usize,
     /// Small corners: point and protecting radius (the influence the report counts in).
     pub small_corners: Vec<(glam::DVec3, f64)>,
@@ -135,6 +140,7 @@ pub fn mesh(
         surface_report.max_rho_away_from_small_corners,
     ) = measure::small_corner_figures(&mesh, &remeshed.small_corners, params);
     report.surface = Some(surface_report);
+    report.input_regions = Some(remeshed.input_regions.clone());
     report.seconds_total = start.elapsed().as_secs_f64();
     Ok((mesh, report))
 }
@@ -259,9 +265,12 @@ fn mesh_restricted(
     let start = std::time::Instant::now();
     let (mut remeshed, volume) = remesh(input, params, spacing, crit, progress)?;
     remeshed.seconds -= volume.seconds_volume;
-    let attribute = input.regions.first().map_or(0, |r| r.attribute);
     let mesh = TetMesh {
-        tet_regions: vec![attribute; volume.tets.len()],
+        tet_regions: volume
+            .regions
+            .iter()
+            .map(|&r| remeshed.region_attributes[r as usize - 1])
+            .collect(),
         vertices: volume.vertices,
         tets: volume.tets,
         boundary: remeshed
@@ -305,7 +314,6 @@ pub fn remesh(
     let start = std::time::Instant::now();
     params.check().map_err(MeshError::InvalidInput)?;
     let plc = crate::plc::validate(input).map_err(|e| MeshError::InvalidInput(e.to_string()))?;
-    check_one_volume(&plc)?;
     let surface = InputSurface::from_plc(&plc);
     let diagonal = surface.bbox_diagonal();
     let default_spacing = ConstantSpacing(DEFAULT_SPACING_FRACTION * diagonal);
@@ -363,6 +371,8 @@ pub fn remesh(
         small_corner_vertices,
         vertex_slide,
         input_volume: plc.volume(),
+        region_attributes: plc.region_attributes(),
+        input_regions: plc.input_regions(),
         n_corners: curves.corners.len(),
         curves,
         small_corners,
@@ -403,24 +413,6 @@ fn slides(b: &restricted::Boundary, curves: &FeatureCurves) -> (Vec<u32>, Vec<Sl
         })
         .collect();
     (small_corner_vertices, vertex_slide)
-}
-
-/// Approximate mode meshes one volume: an input with several (separate cells, or facets
-/// inside the domain making regions) is refused, naming keep mode.
-fn check_one_volume(plc: &crate::plc::Plc) -> Result<(), MeshError> {
-    let domains = plc
-        .cells
-        .iter()
-        .filter(|c| matches!(c.kind, CellKind::Domain { .. }))
-        .count();
-    if domains > 1 || plc.regions.len() > 1 {
-        return Err(MeshError::InvalidInput(format!(
-            "surface mode approximate meshes one volume bounded by closed surfaces; this input \
-             has {domains} separate volumes or regions (facets inside the domain): use \
-             surface mode keep"
-        )));
-    }
-    Ok(())
 }
 
 /// The new boundary as a PLC: one facet per triangle, marked with the input's label of the

@@ -873,51 +873,63 @@ impl<'a> SurfaceMesher<'a> {
         out
     }
 
-    /// The faces between tets whose circumcentres are inside and outside the surface (as
-    /// (inside tet, face index)), and those of them that break the boundary: a vertex off the
-    /// surface, an edge not shared by exactly two faces, or a vertex whose faces do not make
-    /// one disk (two sheets touching at a point, as across a thin part).
+    /// The faces between tets whose circumcentres lie in different regions, one of them not
+    /// outside: the boundary and the interfaces, each once (as (tet, face index), the tet in
+    /// the lower region of the two that is not outside); and those of them that break some
+    /// region's boundary: a vertex off the surface, an edge of that boundary not shared by
+    /// exactly two of its faces, or a vertex whose faces there do not make one disk (two
+    /// sheets touching at a point, as across a thin part). Each region is checked alone, so
+    /// the edges where three regions meet are not in the way.
     fn extract(&self) -> (Vec<FaceRef>, Vec<FaceRef>) {
-        let mut inside = vec![false; self.dt.tet_capacity()];
+        let mut region = vec![0u32; self.dt.tet_capacity()];
         for t in self.dt.finite_tet_ids() {
-            inside[t as usize] = self.is_inside(t);
+            region[t as usize] = self.region_of(t);
         }
-        let mut faces = vec![];
+        // Every region's side of every face of its boundary.
+        let mut sides: Vec<(u32, FaceRef)> = vec![];
         for t in self.dt.finite_tet_ids() {
-            if !inside[t as usize] {
+            let r = region[t as usize];
+            if r == 0 {
                 continue;
             }
             for (i, n) in self.dt.neighbors(t).iter().enumerate() {
-                if !inside[*n as usize] {
-                    faces.push((t, i));
+                if region[*n as usize] != r {
+                    sides.push((r, (t, i)));
                 }
             }
         }
-        let mut edge_count: FxHashMap<[u32; 2], u32> = FxHashMap::default();
-        for &(t, i) in &faces {
-            let tv = self.dt.tet(t);
-            let f = FACE[i].map(|k| tv[k]);
+        let face_of = |(t, i): FaceRef| FACE[i].map(|k| self.dt.tet(t)[k]);
+        let mut edge_count: FxHashMap<(u32, [u32; 2]), u32> = FxHashMap::default();
+        for &(r, f) in &sides {
+            let f = face_of(f);
             for j in 0..3 {
-                *edge_count.entry(key2(f[j], f[(j + 1) % 3])).or_default() += 1;
+                *edge_count
+                    .entry((r, key2(f[j], f[(j + 1) % 3])))
+                    .or_default() += 1;
             }
         }
-        let pinched = pinched_vertices(
-            faces
-                .iter()
-                .map(|&(t, i)| FACE[i].map(|k| self.dt.tet(t)[k])),
-        );
-        let problems = faces
+        let n_regions = sides.iter().map(|s| s.0).max().unwrap_or(0);
+        let mut pinched: FxHashSet<u32> = FxHashSet::default();
+        for r in 1..=n_regions {
+            let of_region = sides.iter().filter(|s| s.0 == r).map(|s| face_of(s.1));
+            pinched.extend(pinched_vertices(of_region));
+        }
+        let breaks = |&(r, f): &(u32, FaceRef)| {
+            let f = face_of(f);
+            f.iter().any(|&v| {
+                v == INFINITE
+                    || matches!(self.loc[v as usize], Loc::Far | Loc::Volume)
+                    || pinched.contains(&v)
+            }) || (0..3).any(|j| edge_count[&(r, key2(f[j], f[(j + 1) % 3]))] != 2)
+        };
+        let problems = sides.iter().filter(|s| breaks(s)).map(|s| s.1).collect();
+        let faces = sides
             .iter()
-            .copied()
-            .filter(|&(t, i)| {
-                let tv = self.dt.tet(t);
-                let f = FACE[i].map(|k| tv[k]);
-                f.iter().any(|&v| {
-                    v == INFINITE
-                        || matches!(self.loc[v as usize], Loc::Far | Loc::Volume)
-                        || pinched.contains(&v)
-                }) || (0..3).any(|j| edge_count[&key2(f[j], f[(j + 1) % 3])] != 2)
+            .filter(|&&(r, (t, i))| {
+                let other = region[self.dt.neighbors(t)[i] as usize];
+                other == 0 || r < other
             })
+            .map(|s| s.1)
             .collect();
         (faces, problems)
     }
@@ -971,7 +983,8 @@ impl<'a> SurfaceMesher<'a> {
         let mut new_id: FxHashMap<u32, u32> = FxHashMap::default();
         for (t, i) in faces {
             let tv = self.dt.tet(t);
-            // FACE[i] turns its normal into tet t (inside): reversed, it points outwards.
+            // FACE[i] turns its normal into tet t (inside): reversed, it points out of t's
+            // region (the lower one at an interface).
             let f = FACE[i].map(|k| tv[k]);
             let tri = [f[0], f[2], f[1]].map(|v| {
                 *new_id.entry(v).or_insert_with(|| {
@@ -1008,6 +1021,8 @@ pub struct VolumeMesh {
     /// The boundary's points, then the vertices inside.
     pub vertices: Vec<DVec3>,
     pub tets: Vec<[u32; 4]>,
+    /// The region of each tet (`InputSurface::sides`' numbering, from 1).
+    pub regions: Vec<u32>,
     /// The cells' spacing when the caller gave none (graded from the surface).
     pub spacing: Option<crate::refine::AutoSpacing>,
     /// Time spent on the surface alone, then on the cells (with the surface refinement they
@@ -1029,11 +1044,13 @@ impl SurfaceMesher<'_> {
             .enumerate()
             .map(|(i, p)| (p.to_array().map(f64::to_bits), i as u32))
             .collect();
-        let mut tets = vec![];
+        let (mut tets, mut regions) = (vec![], vec![]);
         for t in self.dt.finite_tet_ids() {
-            if !self.is_inside(t) {
+            let region = self.region_of(t);
+            if region == 0 {
                 continue;
             }
+            regions.push(region);
             let tv = self.dt.tet(t);
             if tv.iter().any(|&v| self.loc[v as usize] == Loc::Far) {
                 return Err(MeshError::Internal(
@@ -1056,6 +1073,7 @@ impl SurfaceMesher<'_> {
         Ok(VolumeMesh {
             vertices,
             tets,
+            regions,
             ..VolumeMesh::default()
         })
     }

@@ -204,13 +204,54 @@ fn open_surface_is_refused_in_approximate_mode() {
     assert!(matches!(e, MeshError::InvalidInput(_)), "{e}");
 }
 
-/// Internal facets (two materials) are not a surface description: refused with a message
-/// that names the other mode.
+/// Two materials of a .poly (two unit cubes sharing a face, region attributes 1 and 2): each
+/// region keeps its attribute and its volume, the shared face is an interface of one tet of
+/// each region on every triangle, written once among the boundary triangles.
 #[test]
-fn internal_facets_are_refused_in_approximate_mode() {
+fn two_materials_keep_their_attributes_and_interface() {
     let input = model("poly/two_materials.poly");
-    let e = mesh(&input, &approximate(), None, None).unwrap_err();
-    assert!(e.to_string().contains("keep"), "{e}");
+    let (m, _) = crate::pipeline::mesh(&input, &approximate(), None, None).unwrap();
+    let mut volume: std::collections::BTreeMap<i32, f64> = Default::default();
+    let mut faces: std::collections::HashMap<[u32; 3], Vec<i32>> = Default::default();
+    for (t, &r) in m.tets.iter().zip(&m.tet_regions) {
+        let p = t.map(|v| m.vertices[v as usize]);
+        *volume.entry(r).or_default() += crate::geom::orient3d(p[0], p[1], p[2], p[3]) / 6.0;
+        for k in 0..4 {
+            let mut f = [t[(k + 1) % 4], t[(k + 2) % 4], t[(k + 3) % 4]];
+            f.sort_unstable();
+            faces.entry(f).or_default().push(r);
+        }
+    }
+    assert_eq!(volume.keys().copied().collect::<Vec<_>>(), vec![1, 2]);
+    for (r, v) in &volume {
+        assert!((v - 1.0).abs() < 1e-9, "region {r}: volume {v}");
+    }
+    let written: std::collections::HashSet<[u32; 3]> = m
+        .boundary
+        .iter()
+        .map(|f| {
+            let mut f = *f;
+            f.sort_unstable();
+            f
+        })
+        .collect();
+    let mut interface_area = 0.0;
+    for (f, regions) in &faces {
+        assert!(regions.len() <= 2, "face {f:?} of {} tets", regions.len());
+        if regions.len() == 2 && regions[0] != regions[1] {
+            assert!(written.contains(f), "interface face {f:?} not written");
+            let [a, b, c] = f.map(|v| m.vertices[v as usize]);
+            interface_area += (b - a).cross(c - a).length() / 2.0;
+            assert!(
+                a.x == 1.0 && b.x == 1.0 && c.x == 1.0,
+                "interface face {f:?} off x = 1"
+            );
+        }
+    }
+    assert!(
+        (interface_area - 1.0).abs() < 1e-9,
+        "interface area {interface_area}"
+    );
 }
 
 /// Every triangulated model, the noisy elephant scan included, at the defaults: completes

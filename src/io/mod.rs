@@ -33,6 +33,7 @@ pub mod off;
 pub mod ply;
 pub mod points;
 pub mod poly;
+mod solids;
 pub mod stl;
 pub mod tetgen;
 mod text;

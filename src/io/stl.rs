@@ -16,7 +16,12 @@
 //! `ReadOptions::merge_coplanar` the facets are merged by
 //! [`crate::plc::coplanar::merge_coplanar_facets`], which renumbers markers the same way.
 //! Binary coordinates that are not finite are an error naming the triangle.
+//!
+//! Several `solid` blocks are several solids (`super::solids`): a triangle listed by two of
+//! them is one interface facet, and each solid gets a region seed with attribute 1, 2, ...
+//! in file order.
 
+use super::solids::Solids;
 use super::text::{err_at, err_file, read_bytes, with_path, Tokens};
 use super::{IoError, ReadOptions};
 use crate::plc::{Facet, PlcInput};
@@ -51,11 +56,21 @@ pub fn parse_stl(bytes: &[u8], options: &ReadOptions) -> Result<PlcInput, IoErro
         let text = String::from_utf8_lossy(bytes);
         parse_ascii(&text, &mut soup)?;
     }
+    let mut solids = Solids {
+        triangles: soup.triangles,
+        solid_of: soup.solid_of,
+    };
+    let mut regions = vec![];
+    if soup.n_solids > 1 {
+        regions = solids.region_seeds(&soup.vertices, soup.n_solids);
+        solids.merge_shared();
+    }
     let mut plc = PlcInput {
         vertices: soup.vertices,
+        regions,
         ..PlcInput::default()
     };
-    plc.facets = soup
+    plc.facets = solids
         .triangles
         .into_iter()
         .enumerate()
@@ -77,6 +92,10 @@ struct Soup {
     vertices: Vec<DVec3>,
     ids: FxHashMap<[u64; 3], u32>,
     triangles: Vec<Vec<u32>>,
+    /// The `solid` block (0-based) each triangle was read in, and the current one.
+    solid_of: Vec<u32>,
+    solid: u32,
+    n_solids: usize,
 }
 
 impl Soup {
@@ -114,6 +133,7 @@ impl Soup {
         sorted.dedup();
         if poly.len() >= 3 && sorted.len() == poly.len() {
             self.triangles.push(poly);
+            self.solid_of.push(self.solid);
         }
         Ok(())
     }
@@ -178,6 +198,7 @@ fn parse_ascii(text: &str, soup: &mut Soup) -> Result<(), IoError> {
             return Err(err_at(line, format!("expected 'solid', found '{w}'")));
         }
         tok.skip_line(); // the solid's name
+        soup.solid = solids as u32;
         solids += 1;
         loop {
             let (line, w) = tok.next("'facet' or 'endsolid'")?;
@@ -227,6 +248,7 @@ fn parse_ascii(text: &str, soup: &mut Soup) -> Result<(), IoError> {
     if solids == 0 {
         return Err(err_at(1, "empty ASCII STL: no 'solid'"));
     }
+    soup.n_solids = solids;
     Ok(())
 }
 
@@ -273,6 +295,47 @@ mod tests {
         assert_eq!(a.facets[3].marker, 4);
         let b = parse_stl(&binary(&TET_TRIS, 4), &ReadOptions::default()).unwrap();
         assert_eq!(a, b);
+    }
+
+    /// Two solids sharing a face: the face is read once (an interface), and each solid gets
+    /// a region seed, attribute 1 and 2 in file order, that the validator places in it.
+    #[test]
+    fn two_solids_share_their_common_face_and_get_regions() {
+        let solid = |name: &str, tris: &[[[f64; 3]; 3]]| {
+            let mut s = format!("solid {name}\n");
+            for t in tris {
+                s += "facet normal 0 0 0\nouter loop\n";
+                for p in t {
+                    s += &format!("vertex {} {} {}\n", p[0], p[1], p[2]);
+                }
+                s += "endloop\nendfacet\n";
+            }
+            s + &format!("endsolid {name}\n")
+        };
+        let (o, x, y, z, w) = (
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [1.0, 1.0, 1.0],
+        );
+        // Outward: the corner tet, and the one beyond its slanted face.
+        let a = solid("corner", &[[o, y, x], [o, x, z], [o, z, y], [x, y, z]]);
+        let b = solid("beyond", &[[x, z, y], [x, y, w], [y, z, w], [z, x, w]]);
+        let plc = parse_stl((a + &b).as_bytes(), &ReadOptions::default()).unwrap();
+        assert_eq!(plc.facets.len(), 7, "the common face once");
+        let attributes: Vec<i32> = plc.regions.iter().map(|r| r.attribute).collect();
+        assert_eq!(attributes, vec![1, 2]);
+        let checked = crate::plc::validate(&plc).unwrap();
+        assert_eq!(checked.region_attributes(), vec![1, 2]);
+        let volumes: Vec<f64> = checked
+            .input_regions()
+            .volumes
+            .iter()
+            .map(|v| v.1)
+            .collect();
+        assert!((volumes[0] - 1.0 / 6.0).abs() < 1e-12 && (volumes[1] - 1.0 / 3.0).abs() < 1e-12);
+        assert!((checked.input_regions().interface_area - 3f64.sqrt() / 2.0).abs() < 1e-12);
     }
 
     #[test]

@@ -50,6 +50,15 @@ pub struct Region {
     pub max_size: Option<f64>,
 }
 
+/// What the report compares each output region with (`Plc::input_regions`).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct InputRegions {
+    /// (attribute, volume), sorted by attribute.
+    pub volumes: Vec<(i32, f64)>,
+    /// Area of the faces between regions of different attributes.
+    pub interface_area: f64,
+}
+
 /// The unvalidated domain description, as read from a file or built through the API.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct PlcInput {
@@ -84,6 +93,76 @@ impl Plc {
             .filter(|c| matches!(c.kind, CellKind::Domain { .. }))
             .map(|c| c.volume)
             .sum()
+    }
+
+    /// The cells to be meshed (bounded, not holes), in cell order: what `region_of_cell`
+    /// numbers 1, 2, ...
+    pub fn domain_cells(&self) -> impl Iterator<Item = (usize, &Cell)> {
+        self.cells
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| matches!(c.kind, CellKind::Domain { .. }))
+    }
+
+    /// Per cell: 0 for the exterior and holes, else the cell's place in `domain_cells` + 1.
+    pub fn region_of_cell(&self) -> Vec<u32> {
+        let mut out = vec![0; self.cells.len()];
+        for (k, (c, _)) in self.domain_cells().enumerate() {
+            out[c] = k as u32 + 1;
+        }
+        out
+    }
+
+    /// The attribute of each domain cell, in `domain_cells` order: its region seed's where
+    /// one lies in it; else, when the input has no region seeds and more than one domain
+    /// cell, its place in that order (1, 2, ...: the order in which the cells' outer
+    /// boundaries first appear among the facets); else 0.
+    pub fn region_attributes(&self) -> Vec<i32> {
+        let n = self.domain_cells().count();
+        let number = self.regions.is_empty() && n > 1;
+        self.domain_cells()
+            .enumerate()
+            .map(|(k, (_, c))| match c.kind {
+                CellKind::Domain { region: Some(r) } => self.regions[r].attribute,
+                _ if number => k as i32 + 1,
+                _ => 0,
+            })
+            .collect()
+    }
+
+    /// The input's regions: the volume of each attribute (`region_attributes`; cells with the
+    /// same attribute summed, sorted by attribute) and the area of the facet triangles between
+    /// two domain cells of different attributes.
+    pub fn input_regions(&self) -> InputRegions {
+        let attributes = self.region_attributes();
+        let mut volumes: Vec<(i32, f64)> = vec![];
+        for (&a, (_, c)) in attributes.iter().zip(self.domain_cells()) {
+            match volumes.iter_mut().find(|v| v.0 == a) {
+                Some(v) => v.1 += c.volume,
+                None => volumes.push((a, c.volume)),
+            }
+        }
+        volumes.sort_by_key(|v| v.0);
+        let region_of_cell = self.region_of_cell();
+        let attribute = |c: u32| match region_of_cell[c as usize] {
+            0 => None,
+            r => Some(attributes[r as usize - 1]),
+        };
+        let mut interface_area = 0.0;
+        for f in &self.facets {
+            for (t, cells) in f.triangles.iter().zip(&f.triangle_cells) {
+                if let (Some(x), Some(y)) = (attribute(cells[0]), attribute(cells[1])) {
+                    if x != y {
+                        let [a, b, c] = t.map(|v| self.vertices[v as usize]);
+                        interface_area += (b - a).cross(c - a).length() / 2.0;
+                    }
+                }
+            }
+        }
+        InputRegions {
+            volumes,
+            interface_area,
+        }
     }
 
     /// Sum of all facet areas.

@@ -7,7 +7,10 @@ use super::domain::{tri_key, Domain, VertexKind};
 use super::MeshError;
 use crate::delaunay::{tables::FACE, INFINITE};
 use crate::plc::{CellKind, Plc};
+use crate::surface::oracle::SurfaceOracle;
+use crate::surface::InputSurface;
 use crate::union_find::UnionFind;
+use glam::DVec3;
 use rustc_hash::FxHashMap;
 
 /// Region attribute and size limit of each component tag (index 0 = outside, unused).
@@ -66,6 +69,8 @@ impl Domain {
             for (out, a) in outside.iter_mut().zip(&attribute) {
                 *out |= a.is_none();
             }
+        } else {
+            self.number_unseeded(plc, &comp, &outside, &mut attribute);
         }
         // Tags: 0 outside, then one per inside component.
         let mut tag_of = vec![0u32; n_comp as usize];
@@ -91,6 +96,39 @@ impl Domain {
             }
         }
         Ok(regions)
+    }
+
+    /// Gives each inside component without a region seed the attribute its PLC cell has in
+    /// `Plc::region_attributes` (1, 2, ... when the input has no seeds and several cells):
+    /// the cell is the input region holding the centroid of one of its tets, found by the
+    /// exact ray crossings of `surface::oracle`.
+    fn number_unseeded(
+        &self,
+        plc: &Plc,
+        comp: &[u32],
+        outside: &[bool],
+        attribute: &mut [Option<i32>],
+    ) {
+        let attributes = plc.region_attributes();
+        if !attributes.iter().any(|&a| a != 0) || !plc.regions.is_empty() {
+            return;
+        }
+        let oracle = SurfaceOracle::new(&InputSurface::from_plc(plc));
+        for t in self.dt.finite_tet_ids() {
+            let c = comp[t as usize] as usize;
+            if outside[c] || attribute[c].is_some() {
+                continue;
+            }
+            let centroid = self
+                .dt
+                .tet(t)
+                .map(|v| self.dt.point(v))
+                .iter()
+                .sum::<DVec3>()
+                / 4.0;
+            let region = oracle.region(centroid) as usize;
+            attribute[c] = Some(attributes.get(region.wrapping_sub(1)).copied().unwrap_or(0));
+        }
     }
 
     /// Gives the tets in `created` (made since the boundary was last complete) the tag of the

@@ -299,6 +299,25 @@ pub struct Report {
     pub improvement: crate::improve::Stats,
     /// Approximate surface mode only: how close the output boundary is to the input surface.
     pub surface: Option<SurfaceReport>,
+    /// Per region attribute of the output (sorted): its tets and volume against the input's.
+    pub regions: Vec<RegionReport>,
+    /// Area of the output faces between tets of different regions, and of the input's.
+    pub interface_area: f64,
+    pub input_interface_area: f64,
+    /// The input's regions, from the surface mode until `measure_regions` compares with them.
+    #[serde(skip)]
+    pub input_regions: Option<crate::plc::InputRegions>,
+}
+
+/// One region of the output (all tets of one attribute) against the input's.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
+pub struct RegionReport {
+    pub attribute: i32,
+    pub tets: usize,
+    pub volume: f64,
+    pub input_volume: f64,
+    /// (volume - input_volume) / input_volume.
+    pub relative_volume_difference: f64,
 }
 
 /// How well the output boundary approximates the input surface (approximate mode).
@@ -508,6 +527,7 @@ fn mesh_domain(
         ));
     }
     report.stop_reason = stop_reason;
+    report.input_regions = Some(plc.input_regions());
     Ok((mesh, report))
 }
 

@@ -155,6 +155,63 @@ fn checked(spacing: &dyn Spacing, p: glam::DVec3) -> Result<f64, MeshError> {
 }
 
 impl Report {
+    /// Measures each region of `mesh` and its interfaces against the input's regions the
+    /// surface mode left in `input_regions` (none: nothing measured).
+    pub fn measure_regions(&mut self, mesh: &TetMesh) {
+        let Some(input) = self.input_regions.take() else {
+            return;
+        };
+        let mut regions: Vec<super::RegionReport> = input
+            .volumes
+            .iter()
+            .map(|&(attribute, input_volume)| super::RegionReport {
+                attribute,
+                input_volume,
+                ..Default::default()
+            })
+            .collect();
+        // Interfaces only where there are two attributes (the face map costs 100 bytes a tet).
+        let several = mesh.tet_regions.iter().any(|&a| a != mesh.tet_regions[0]);
+        let mut faces: rustc_hash::FxHashMap<[u32; 3], i32> = Default::default();
+        let mut interface_area = 0.0;
+        for (t, &a) in mesh.tets.iter().zip(&mesh.tet_regions) {
+            let p = t.map(|v| mesh.vertices[v as usize]);
+            let r = match regions.iter().position(|r| r.attribute == a) {
+                Some(r) => r,
+                None => {
+                    regions.push(super::RegionReport {
+                        attribute: a,
+                        ..Default::default()
+                    });
+                    regions.len() - 1
+                }
+            };
+            regions[r].tets += 1;
+            regions[r].volume += (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0;
+            for k in (0..4).filter(|_| several) {
+                let mut f = [t[(k + 1) % 4], t[(k + 2) % 4], t[(k + 3) % 4]];
+                f.sort_unstable();
+                if let Some(b) = faces.insert(f, a) {
+                    if b != a {
+                        let [x, y, z] = f.map(|v| mesh.vertices[v as usize]);
+                        interface_area += (y - x).cross(z - x).length() / 2.0;
+                    }
+                }
+            }
+        }
+        for r in &mut regions {
+            r.relative_volume_difference = if r.input_volume > 0.0 {
+                (r.volume - r.input_volume) / r.input_volume
+            } else {
+                f64::NAN
+            };
+        }
+        regions.sort_by_key(|r| r.attribute);
+        self.regions = regions;
+        self.interface_area = interface_area;
+        self.input_interface_area = input.interface_area;
+    }
+
     /// Takes the figures [`measure`] fills in (counts, shapes, sizes, bad tets near small
     /// angles) from `m`, a report it made; the rest of `self` stays.
     pub fn take_measures(&mut self, m: Report) {
@@ -236,6 +293,24 @@ impl Report {
             self.n_bad_near_acute.to_string(),
         );
         row("refinement refusals", self.refusals.summary());
+        if self.regions.len() > 1 {
+            for r in &self.regions {
+                row(
+                    &format!("region {}: tets / volume", r.attribute),
+                    format!(
+                        "{} / {:.6e} (input {:.6e}, {:+.3e})",
+                        r.tets, r.volume, r.input_volume, r.relative_volume_difference
+                    ),
+                );
+            }
+            row(
+                "interface area / input",
+                format!(
+                    "{:.6e} / {:.6e}",
+                    self.interface_area, self.input_interface_area
+                ),
+            );
+        }
         row(
             "complete",
             match &self.stop_reason {

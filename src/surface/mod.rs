@@ -33,6 +33,10 @@ pub struct InputSurface {
     pub facet_of: Vec<u32>,
     /// Marker of that facet.
     pub marker_of: Vec<i32>,
+    /// The region on each side of each triangle (normal side first): 0 outside the domain
+    /// (the exterior and holes), else the [`Plc::domain_cells`] index + 1. A triangle between
+    /// two regions is an interface.
+    pub sides: Vec<[u32; 2]>,
 }
 
 impl InputSurface {
@@ -43,18 +47,23 @@ impl InputSurface {
             triangles: Vec::new(),
             facet_of: Vec::new(),
             marker_of: Vec::new(),
+            sides: Vec::new(),
         };
+        let region_of_cell = plc.region_of_cell();
         for (k, f) in plc.facets.iter().enumerate() {
-            for &t in &f.triangles {
+            for (i, &t) in f.triangles.iter().enumerate() {
                 s.triangles.push(t);
                 s.facet_of.push(k as u32);
                 s.marker_of.push(f.marker);
+                let cells = f.triangle_cells.get(i).copied().unwrap_or([0, 0]);
+                s.sides.push(cells.map(|c| region_of_cell[c as usize]));
             }
         }
         s
     }
 
-    /// A surface from raw triangles (one facet per triangle, marker 0).
+    /// A surface from raw triangles (one facet per triangle, marker 0) bounding one region:
+    /// each triangle has region 1 on one side and the outside on the other.
     pub fn from_triangles(vertices: Vec<DVec3>, triangles: Vec<[u32; 3]>) -> InputSurface {
         let n = triangles.len();
         InputSurface {
@@ -62,7 +71,13 @@ impl InputSurface {
             triangles,
             facet_of: (0..n as u32).collect(),
             marker_of: vec![0; n],
+            sides: vec![[1, 0]; n],
         }
+    }
+
+    /// Number of regions (the largest label in `sides`).
+    pub fn n_regions(&self) -> u32 {
+        self.sides.iter().flatten().copied().max().unwrap_or(0)
     }
 
     /// The corner points of triangle `t`.

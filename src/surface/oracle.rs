@@ -63,6 +63,8 @@ pub struct Crossing {
     /// In [0, 1] from the segment's start (the middle of the overlap for a coplanar segment).
     pub t: f64,
     pub point: DVec3,
+    /// Through the triangle's interior, not an edge, a vertex or an end of the segment.
+    pub proper: bool,
 }
 
 /// Where a point lies relative to a closed surface.
@@ -92,6 +94,8 @@ pub struct SurfaceOracle {
     flat: Vec<bool>,
     /// Per triangle: its [`Frame`] (None when it has no area to speak of).
     frames: Vec<Option<Frame>>,
+    /// Per triangle: the regions on its two sides (`InputSurface::sides`).
+    sides: Vec<[u32; 2]>,
     pad: f64,
     diagonal: f64,
 }
@@ -133,6 +137,7 @@ impl SurfaceOracle {
                 Occupancy::empty()
             },
             frames: corners.iter().map(|&c| Frame::of(c)).collect(),
+            sides: surface.sides.clone(),
             corners,
             pieces,
             flat: (0..n).map(|t| is_flat(surface.corners(t))).collect(),
@@ -427,6 +432,7 @@ impl SurfaceOracle {
                     triangle: t,
                     t: t_param,
                     point: p + (q - p) * t_param,
+                    proper,
                 });
                 if proper {
                     odd = !odd;
@@ -437,6 +443,85 @@ impl SurfaceOracle {
         });
         out.sort_by(|x, y| x.t.total_cmp(&y.t).then(x.triangle.cmp(&y.triangle)));
         (out, clean.then_some(odd))
+    }
+
+    /// The region at the end of a segment that starts in region `from` and meets `crossings`
+    /// (sorted along it, as [`Self::crossings`] gives them): each crossing passes from one
+    /// side of its triangle to the other. None when that is not clean to tell: a crossing is
+    /// not proper, or the region reached is on neither side of the next triangle (crossings
+    /// whose order rounding decided). With one region this is the parity of the crossings.
+    pub fn region_across<'c>(
+        &self,
+        from: u32,
+        crossings: impl IntoIterator<Item = &'c Crossing>,
+    ) -> Option<u32> {
+        crossings.into_iter().try_fold(from, |r, x| {
+            let [a, b] = self.sides[x.triangle as usize];
+            match () {
+                _ if !x.proper => None,
+                _ if r == a => Some(b),
+                _ if r == b => Some(a),
+                _ => None,
+            }
+        })
+    }
+
+    /// The region `p` lies in (`InputSurface::sides`: 0 outside), from the crossings of a
+    /// ray walked back from its far end, which is outside; a ray that touches an edge, a
+    /// vertex or a triangle's plane, or whose crossings do not chain, is replaced by another.
+    /// A point on the surface gets the larger region of a triangle it lies on.
+    pub fn region(&self, p: DVec3) -> u32 {
+        let far = 4.0 * self.diagonal.max(1.0) + p.abs().max_element();
+        for k in 0..MAX_RAYS {
+            let q = p + ray_direction(k) * far;
+            match self.ray_region(p, q) {
+                Some(Ok(r)) => return r,
+                Some(Err(t)) => return self.sides[t as usize][0].max(self.sides[t as usize][1]),
+                None => continue,
+            }
+        }
+        // Only a point on the surface's edges grazes every one of MAX_RAYS directions.
+        self.closest(p).map_or(0, |c| {
+            let [a, b] = self.sides[c.triangle as usize];
+            a.max(b)
+        })
+    }
+
+    /// Some(Ok(region)) for a clean ray, Some(Err(triangle)) when p lies on that triangle,
+    /// None when degenerate.
+    fn ray_region(&self, p: DVec3, q: DVec3) -> Option<Result<u32, u32>> {
+        let mut hits: Vec<Crossing> = Vec::new();
+        let mut degenerate = false;
+        let mut on = None;
+        self.visit_segment(p, q, |t| {
+            if degenerate || on.is_some() || self.flat[t as usize] {
+                return;
+            }
+            let [a, b, c] = self.corners[t as usize];
+            match proper_crossing(p, q, a, b, c) {
+                Crossed::No => {}
+                Crossed::Yes => {
+                    let (dp, dq) = (orient3d(a, b, c, p), orient3d(a, b, c, q));
+                    hits.push(Crossing {
+                        triangle: t,
+                        t: dp / (dp - dq),
+                        point: p,
+                        proper: true,
+                    });
+                }
+                Crossed::Degenerate => degenerate = true,
+                Crossed::StartsOn => on = Some(t),
+            }
+        });
+        if let Some(t) = on {
+            return Some(Err(t));
+        }
+        if degenerate {
+            return None;
+        }
+        // From q (outside) back to p.
+        hits.sort_by(|x, y| y.t.total_cmp(&x.t).then(x.triangle.cmp(&y.triangle)));
+        self.region_across(0, &hits).map(Ok)
     }
 
     /// Inside, outside or on the closed surface, by the parity of proper crossings of a ray;

@@ -482,3 +482,86 @@ fn assert_covered(
         );
     }
 }
+
+/// Two prisms, one inside the other, read through a PLC: three regions (outside 0, the shell
+/// 1, the inner prism 2). A point's region by rays, and carried along random segments by
+/// their crossings, agree with where the point is.
+#[test]
+fn regions_of_nested_prisms() {
+    let outer = prism(12, 2.0);
+    let mut inner = prism(12, 1.0);
+    for p in &mut inner.vertices {
+        *p = DVec3::new(0.5 * p.x, 0.5 * p.y, p.z + 0.5);
+    }
+    let mut input = crate::plc::PlcInput {
+        vertices: outer.vertices.clone(),
+        ..Default::default()
+    };
+    let shift = outer.vertices.len() as u32;
+    input.vertices.extend(&inner.vertices);
+    for (k, t) in outer
+        .triangles
+        .iter()
+        .chain(
+            inner
+                .triangles
+                .iter()
+                .map(|t| t.map(|v| v + shift))
+                .collect::<Vec<_>>()
+                .iter(),
+        )
+        .enumerate()
+    {
+        input.facets.push(crate::plc::Facet {
+            polygons: vec![t.to_vec()],
+            marker: k as i32 + 1,
+            ..Default::default()
+        });
+    }
+    let plc = validate(&input).unwrap();
+    assert_eq!(plc.region_attributes(), vec![1, 2], "no seeds: numbered");
+    let s = InputSurface::from_plc(&plc);
+    assert_eq!(s.n_regions(), 2);
+    let o = SurfaceOracle::new(&s);
+    let truth = |p: DVec3| {
+        let r = DVec3::new(p.x, p.y, 0.0).length();
+        // Inside the 12-gon of circumradius c (tested against its inradius and circumradius,
+        // points in between skipped).
+        let within = |c: f64, lo: f64, hi: f64| {
+            let inr = c * (std::f64::consts::PI / 12.0).cos();
+            if r < inr && p.z > lo && p.z < hi {
+                Some(true)
+            } else if r > c || p.z < lo || p.z > hi {
+                Some(false)
+            } else {
+                None
+            }
+        };
+        match (within(1.0, 0.0, 2.0)?, within(0.5, 0.5, 1.5)?) {
+            (false, _) => Some(0),
+            (true, false) => Some(1),
+            (true, true) => Some(2),
+        }
+    };
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let mut point = || {
+        DVec3::new(
+            rng.gen_range(-1.5..1.5),
+            rng.gen_range(-1.5..1.5),
+            rng.gen_range(-0.5..2.5),
+        )
+    };
+    let mut checked = 0;
+    for _ in 0..2000 {
+        let (p, q) = (point(), point());
+        let (Some(rp), Some(rq)) = (truth(p), truth(q)) else {
+            continue;
+        };
+        assert_eq!(o.region(p), rp, "region of {p}");
+        if let Some(r) = o.region_across(rp, &o.crossings(p, q)) {
+            assert_eq!(r, rq, "carried from {p} to {q}");
+            checked += 1;
+        }
+    }
+    assert!(checked > 1000, "{checked} segments carried cleanly");
+}

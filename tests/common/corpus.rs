@@ -33,6 +33,16 @@ impl Surface {
         six_v / 6.0
     }
 
+    /// Total triangle area.
+    pub fn area(&self) -> f64 {
+        (0..self.triangles.len())
+            .map(|t| {
+                let [a, b, c] = self.corners(t);
+                (b - a).cross(c - a).length() / 2.0
+            })
+            .sum()
+    }
+
     pub fn bbox(&self) -> (DVec3, DVec3) {
         self.vertices.iter().fold(
             (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)),
@@ -235,6 +245,8 @@ pub struct Shape {
     /// Volume of the smooth or exact shape the triangles describe, and the relative difference
     /// allowed between it and the triangles' volume (the tessellation's deficit).
     pub analytic_volume: Option<(f64, f64)>,
+    /// Area of the faces between two regions (0 for one body or bodies apart).
+    pub interface_area: f64,
 }
 
 impl Shape {
@@ -245,6 +257,7 @@ impl Shape {
             solids: vec![s],
             stl: false,
             analytic_volume,
+            interface_area: 0.0,
         }
     }
 
@@ -465,6 +478,7 @@ pub fn two_bodies() -> Shape {
         solids: vec![a, b],
         stl: false,
         analytic_volume: Some((exact, 3e-3)),
+        interface_area: 0.0,
     }
 }
 
@@ -473,8 +487,10 @@ pub fn two_bodies() -> Shape {
 pub fn sphere_in_box() -> Shape {
     let b = grid_box(DVec3::splat(-1.5), DVec3::splat(1.5), [4, 4, 4]);
     let s = icosphere(4);
+    let interface_area = s.area();
     Shape {
         name: "sphere_in_box",
+        interface_area,
         part_volumes: vec![b.volume() - s.volume(), s.volume()],
         solids: vec![b, s],
         stl: false,
@@ -493,6 +509,7 @@ pub fn two_touching_blocks_stl() -> Shape {
         solids: vec![a, b],
         stl: true,
         analytic_volume: Some((2.0, 1e-12)),
+        interface_area: 1.0,
     }
 }
 
@@ -515,6 +532,7 @@ pub fn three_regions_edge() -> Shape {
         solids,
         stl: true,
         analytic_volume: Some((1.5 * 3f64.sqrt(), 1e-12)),
+        interface_area: 3.0,
     }
 }
 

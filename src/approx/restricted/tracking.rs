@@ -1,18 +1,19 @@
 //! What the restricted mesher keeps up to date at every insertion, for both levels: each tet's
-//! circumcentre and side (its circumcentre inside the surface or not), and the restricted
-//! facets with their surface balls.
+//! circumcentre and region (the input's region holding its circumcentre, 0 outside), and the
+//! restricted facets with their surface balls.
 //!
 //! One walk over the first triangulation classifies everything; afterwards each insertion only
 //! looks at its new tets. Each face's Voronoi edge (the segment between the circumcentres of its
-//! two tets) is crossed with the surface once: that makes the face restricted, and the parity of
-//! its proper crossings says whether the side changes from one tet to the other (a ray decides
-//! where a crossing is not proper or a circumcentre is missing).
+//! two tets) is crossed with the surface once: that makes the face restricted, and its proper
+//! crossings, each from one side of an input triangle to the other, carry the region from one
+//! tet to the other (a ray decides where a crossing is not proper or a circumcentre is missing;
+//! with one region this is the parity of the crossings).
 
 use super::{key3, Queued, Restricted, SurfaceMesher};
 use crate::delaunay::tables::FACE;
 use crate::delaunay::{Delaunay, INFINITE};
 use crate::geom::circumsphere;
-use crate::surface::oracle::Side;
+use crate::surface::oracle::Crossing;
 use glam::DVec3;
 use rustc_hash::FxHashMap;
 
@@ -68,8 +69,8 @@ pub(super) struct TetInfo {
     centre: DVec3,
     /// Negative when the tet has no circumsphere (flat or infinite).
     radius: f64,
-    /// The circumcentre lies inside the surface (false without one).
-    inside: bool,
+    /// The region holding the circumcentre (`InputSurface::sides`; 0 outside or without one).
+    region: u32,
     /// Bit i: face i (opposite vertex i) is a key of [`Tracking::restricted`]. Kept exact on
     /// both tets of each face, so that the faces of removed and probed tets that are not
     /// restricted (nearly all) are not looked up in the map.
@@ -81,14 +82,14 @@ impl Default for TetInfo {
         TetInfo {
             centre: DVec3::ZERO,
             radius: -1.0,
-            inside: false,
+            region: 0,
             restricted: 0,
         }
     }
 }
 
 impl TetInfo {
-    /// Tet `tv`'s circumsphere (`geom::circumsphere` of its vertices in their order), side
+    /// Tet `tv`'s circumsphere (`geom::circumsphere` of its vertices in their order), region
     /// not known yet.
     fn of(dt: &Delaunay, tv: [u32; 4]) -> TetInfo {
         if tv.contains(&INFINITE) {
@@ -99,7 +100,7 @@ impl TetInfo {
             Some((centre, radius)) => TetInfo {
                 centre,
                 radius,
-                inside: false,
+                region: 0,
                 restricted: 0,
             },
             None => TetInfo::default(),
@@ -111,7 +112,7 @@ impl TetInfo {
     }
 }
 
-/// Every tet's side and every restricted facet, from one pass over the triangulation.
+/// Every tet's region and every restricted facet, from one pass over the triangulation.
 struct Classified {
     tets: Vec<TetInfo>,
     restricted: Vec<Restricted>,
@@ -147,9 +148,14 @@ impl SurfaceMesher<'_> {
         }
     }
 
-    /// Whether tet `t`'s circumcentre lies inside the surface.
+    /// Whether tet `t`'s circumcentre lies inside the domain (in any region).
     pub(super) fn is_inside(&self, t: u32) -> bool {
-        self.track.tets.get(t as usize).is_some_and(|i| i.inside)
+        self.region_of(t) != 0
+    }
+
+    /// The region holding tet `t`'s circumcentre (0 outside).
+    pub(super) fn region_of(&self, t: u32) -> u32 {
+        self.track.tets.get(t as usize).map_or(0, |i| i.region)
     }
 
     /// The circumcentre and circumradius of live tet `t` (None when flat or infinite), as
@@ -159,21 +165,36 @@ impl SurfaceMesher<'_> {
         info.centre().map(|c| (c, info.radius))
     }
 
-    /// Whether a tet with circumcentre `centre` is inside, given the side of the tet across a
-    /// face and the crossing parity of the segment between their circumcentres (None: not
-    /// clean, or a centre missing; a ray decides). A flat tet (no centre) is outside.
-    fn side_across(&self, other_inside: bool, centre: Option<DVec3>, parity: Option<bool>) -> bool {
-        match (centre, parity) {
-            (None, _) => false,
-            (Some(_), Some(odd)) => other_inside != odd,
-            (Some(c), None) => self.oracle.side(c) != Side::Outside,
+    /// The region of a tet with circumcentre `centre`, given the region of the tet across a
+    /// face and the crossings of the segment between their circumcentres (None: a centre
+    /// missing), ordered from the other tet's centre towards `centre` when `towards`, else
+    /// the other way. Where the crossings do not settle it, a ray does. A flat tet (no
+    /// centre) is outside.
+    fn region_across(
+        &self,
+        other: u32,
+        centre: Option<DVec3>,
+        crossings: Option<&[Crossing]>,
+        towards: bool,
+    ) -> u32 {
+        let carried = |x: &[Crossing]| {
+            if towards {
+                self.oracle.region_across(other, x)
+            } else {
+                self.oracle.region_across(other, x.iter().rev())
+            }
+        };
+        match (centre, crossings) {
+            (None, _) => 0,
+            (Some(c), Some(x)) => carried(x).unwrap_or_else(|| self.oracle.region(c)),
+            (Some(c), None) => self.oracle.region(c),
         }
     }
 
     /// After inserting `new_vertex`: the restricted facets of the removed tets go; the created
-    /// tets get their circumcentre and side, their faces are checked (each Voronoi edge crossed
+    /// tets get their circumcentre and region, their faces are checked (each Voronoi edge crossed
     /// once) and the bad restricted facets queued. A cell-level point whose Voronoi cell misses
-    /// the surface changes none of that but the sides (`surface_untouched`).
+    /// the surface changes none of that but the regions (`surface_untouched`).
     pub(super) fn track_insertion(&mut self, new_vertex: u32, created: &[u32]) {
         let mut track = std::mem::take(&mut self.track);
         let cap = self.dt.tet_capacity();
@@ -187,19 +208,19 @@ impl SurfaceMesher<'_> {
             .iter()
             .map(|&t| track.tets[t as usize])
             .collect();
-        let removed_side = removed
+        let removed_region = removed
             .iter()
-            .find_map(|info| info.centre().map(|_| info.inside));
+            .find_map(|info| info.centre().map(|_| info.region));
         // Then every cavity boundary face had a Voronoi edge, crossed when it last changed.
         let removed_centred = removed.iter().all(|info| info.centre().is_some());
         for &t in created {
             track.tets[t as usize] = TetInfo::of(&self.dt, self.dt.tet(t));
         }
-        if let Some(inside) =
-            removed_side.filter(|_| self.surface_untouched(new_vertex, created, &track.tets))
+        if let Some(region) =
+            removed_region.filter(|_| self.surface_untouched(new_vertex, created, &track.tets))
         {
             for &t in created {
-                track.tets[t as usize].inside = inside;
+                track.tets[t as usize].region = region;
                 // The restricted facets are unchanged: only a face across the cavity's
                 // boundary can be one, and the tet outside still records it.
                 if let Some(i) = outer_face(&self.dt, t, new_vertex) {
@@ -258,17 +279,19 @@ impl SurfaceMesher<'_> {
                 if outer && both_centred && removed_centred && !was_restricted(&before, face) {
                     // The new Voronoi edge is the part of the old one outside the new vertex's
                     // cell: the old one crossed nothing, so neither does it (even parity).
-                    track.tets[t as usize].inside = other.inside;
+                    track.tets[t as usize].region = other.region;
                     track.mark_face(&self.dt, t, i, false);
                     continue;
                 }
-                let (crossings, parity) = match (c, other.centre()) {
-                    (Some(c), Some(cn)) => self.oracle.crossings_and_parity(c, cn),
-                    _ => (vec![], None),
+                let crossings = match (c, other.centre()) {
+                    (Some(c), Some(cn)) => Some(self.oracle.crossings(c, cn)),
+                    _ => None,
                 };
                 if outer {
-                    track.tets[t as usize].inside = self.side_across(other.inside, c, parity);
+                    track.tets[t as usize].region =
+                        self.region_across(other.region, c, crossings.as_deref(), false);
                 }
+                let crossings = crossings.unwrap_or_default();
                 let restricted = Self::facet_from(&self.dt, face, crossings);
                 track.mark_face(&self.dt, t, i, restricted.is_some());
                 if let Some(r) = restricted {
@@ -300,7 +323,7 @@ impl SurfaceMesher<'_> {
     ///   so the same crossings: the same record, judged already;
     /// - the removed tets' inner faces had their Voronoi edges in the cell: none was
     ///   restricted;
-    /// - the cell is on one side of the surface, so all created circumcentres are on the side
+    /// - the cell is in one region, so all created circumcentres are in the region
     ///   of the removed ones (which lie in it too: `v` is nearer to them than any other site).
     fn surface_untouched(&self, v: u32, created: &[u32], tets: &[TetInfo]) -> bool {
         if !matches!(self.loc.get(v as usize), Some(super::Loc::Volume)) {
@@ -330,8 +353,8 @@ impl SurfaceMesher<'_> {
 
     /// [`Classified`]: a walk from tet to neighbouring tet, where the segment between their
     /// circumcentres (the face's Voronoi edge) is crossed once for both questions: it makes
-    /// the face restricted, and the parity of its proper crossings says whether the side
-    /// changes (when a crossing is not proper, or a centre is missing, a ray decides).
+    /// the face restricted, and its crossings carry the region across (when they do not
+    /// settle it, or a centre is missing, a ray decides).
     fn classify_tets(&self) -> Classified {
         let cap = self.dt.tet_capacity();
         let mut out = Classified {
@@ -345,7 +368,7 @@ impl SurfaceMesher<'_> {
             out.tets[t as usize] = TetInfo::of(&self.dt, self.dt.tet(t));
             if queue.is_empty() {
                 if let Some(c) = out.tets[t as usize].centre() {
-                    out.tets[t as usize].inside = self.oracle.side(c) != Side::Outside;
+                    out.tets[t as usize].region = self.oracle.region(c);
                     reached[t as usize] = true;
                     queue.push_back(t);
                 }
@@ -359,16 +382,21 @@ impl SurfaceMesher<'_> {
                     continue;
                 }
                 let (c, cn) = (out.tets[t as usize].centre(), out.tets[n as usize].centre());
-                let (crossings, parity) = match (c, cn) {
-                    (Some(c), Some(cn)) => self.oracle.crossings_and_parity(c, cn),
-                    _ => (vec![], None),
+                let crossings = match (c, cn) {
+                    (Some(c), Some(cn)) => Some(self.oracle.crossings(c, cn)),
+                    _ => None,
                 };
                 if !reached[n as usize] {
                     reached[n as usize] = true;
-                    out.tets[n as usize].inside =
-                        self.side_across(out.tets[t as usize].inside, cn, parity);
+                    out.tets[n as usize].region = self.region_across(
+                        out.tets[t as usize].region,
+                        cn,
+                        crossings.as_deref(),
+                        true,
+                    );
                     queue.push_back(n);
                 }
+                let crossings = crossings.unwrap_or_default();
                 let face = FACE[i].map(|k| tv[k]);
                 if let Some(r) = Self::facet_from(&self.dt, face, crossings) {
                     out.restricted.push(r);

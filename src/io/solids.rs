@@ -1,0 +1,113 @@
+//! Several solids in one surface file (the `solid` blocks of an ASCII STL): a triangle that
+//! two solids share (the same three vertices, listed once by each) is one interface facet,
+//! and each solid gets a region seed with its 1-based place in the file as attribute, so
+//! that the regions are labelled the way the file names them.
+
+use crate::plc::Region;
+use glam::DVec3;
+use rustc_hash::FxHashMap;
+
+/// The triangles of a soup, each with the solid (0-based, file order) it was read in.
+pub struct Solids {
+    pub triangles: Vec<Vec<u32>>,
+    pub solid_of: Vec<u32>,
+}
+
+impl Solids {
+    /// Drops every triangle that an earlier solid already listed with the same vertices (an
+    /// interface: one facet, two regions). Triangles repeated within one solid are kept, for
+    /// the validator to name.
+    pub fn merge_shared(&mut self) {
+        let mut first: FxHashMap<Vec<u32>, u32> = FxHashMap::default();
+        let mut keep = vec![true; self.triangles.len()];
+        for (i, t) in self.triangles.iter().enumerate() {
+            let mut key = t.clone();
+            key.sort_unstable();
+            match first.get(&key) {
+                Some(&j) if self.solid_of[j as usize] != self.solid_of[i] => keep[i] = false,
+                Some(_) => {}
+                None => {
+                    first.insert(key, i as u32);
+                }
+            }
+        }
+        let mut k = keep.iter();
+        self.triangles.retain(|_| *k.next().unwrap_or(&true));
+        let mut k = keep.iter();
+        self.solid_of.retain(|_| *k.next().unwrap_or(&true));
+    }
+
+    /// One region seed per solid of `n_solids` (attribute = its 1-based place): the point
+    /// half-way between the centroid of the solid's largest triangle and the first triangle
+    /// of the whole soup that a ray from there into the solid meets. Which way is into the
+    /// solid comes from the sign of its enclosed volume. `triangles` are those of each solid
+    /// as read (before `merge_shared`). A solid whose ray meets nothing (not closed) gets no
+    /// seed; the validator places seeds exactly.
+    pub fn region_seeds(&self, vertices: &[DVec3], n_solids: usize) -> Vec<Region> {
+        let corners = |t: &[u32]| [t[0], t[1], t[2]].map(|v| vertices[v as usize]);
+        let mut seeds = vec![];
+        for s in 0..n_solids as u32 {
+            let own: Vec<&Vec<u32>> = self
+                .triangles
+                .iter()
+                .zip(&self.solid_of)
+                .filter(|(_, &k)| k == s)
+                .map(|(t, _)| t)
+                .collect();
+            let volume: f64 = own
+                .iter()
+                .map(|t| {
+                    let [a, b, c] = corners(t);
+                    a.dot(b.cross(c))
+                })
+                .sum();
+            let Some(largest) = own.iter().max_by(|x, y| {
+                let area = |t: &[u32]| {
+                    let [a, b, c] = corners(t);
+                    (b - a).cross(c - a).length()
+                };
+                area(x).total_cmp(&area(y))
+            }) else {
+                continue;
+            };
+            let [a, b, c] = corners(largest);
+            let normal = (b - a).cross(c - a).normalize_or_zero();
+            let inwards = if volume >= 0.0 { -normal } else { normal };
+            let from = (a + b + c) / 3.0;
+            let nearest = self
+                .triangles
+                .iter()
+                .filter_map(|t| ray_hit(from, inwards, corners(t)))
+                .filter(|&d| d > 0.0)
+                .fold(f64::INFINITY, f64::min);
+            if nearest.is_finite() {
+                seeds.push(Region {
+                    point: from + inwards * (nearest / 2.0),
+                    attribute: s as i32 + 1,
+                    max_size: None,
+                });
+            }
+        }
+        seeds
+    }
+}
+
+/// Distance along the unit direction `dir` from `from` to triangle `[a, b, c]`, if the ray
+/// meets it away from `from` (Möller–Trumbore; only a seed's construction depends on it).
+fn ray_hit(from: DVec3, dir: DVec3, [a, b, c]: [DVec3; 3]) -> Option<f64> {
+    let (e1, e2) = (b - a, c - a);
+    let p = dir.cross(e2);
+    let det = e1.dot(p);
+    if det.abs() <= 1e-300 {
+        return None;
+    }
+    let s = from - a;
+    let u = s.dot(p) / det;
+    let q = s.cross(e1);
+    let v = dir.dot(q) / det;
+    if !(0.0..=1.0).contains(&u) || v < 0.0 || u + v > 1.0 {
+        return None;
+    }
+    let d = e2.dot(q) / det;
+    (d > 1e-12 * (e1.length() + e2.length())).then_some(d)
+}
