@@ -210,7 +210,8 @@ module slivermesh
       integer(c_int32_t) :: s
     end function sm_get_vertices
 
-    !> tets(4, capacity) 0-based ids; regions(capacity) may be omitted (NULL).
+    !> tets(4, capacity) 0-based ids; regions(capacity) may be omitted (NULL). Regions: the
+    !> seeds' attributes, else 1, 2, ... per enclosed volume (0 for one piece), see slivermesh.h.
     function sm_get_tets(m, tets, regions, capacity) bind(C, name="sm_get_tets") result(s)
       import :: c_ptr, c_size_t, c_int32_t
       type(c_ptr), value :: m
@@ -220,7 +221,8 @@ module slivermesh
       integer(c_int32_t) :: s
     end function sm_get_tets
 
-    !> tris(3, capacity) 0-based ids; markers(capacity) may be omitted (NULL).
+    !> tris(3, capacity) 0-based ids; markers(capacity) may be omitted (NULL). An interface
+    !> between two regions is listed once.
     function sm_get_boundary_faces(m, tris, markers, capacity) &
         bind(C, name="sm_get_boundary_faces") result(s)
       import :: c_ptr, c_size_t, c_int32_t

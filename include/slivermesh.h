@@ -431,7 +431,10 @@ sm_status sm_get_vertices(const sm_mesher *m, double *xyz, size_t capacity);
 
 /**
  * Copies the tetrahedra into `tets` (4 vertex ids per tet, 0-based, positively oriented) and,
- * if `regions` is not NULL, each tet's region attribute into `regions` (0 without regions).
+ * if `regions` is not NULL, each tet's region attribute into `regions`: the region seed's
+ * attribute (`sm_add_region`); without seeds 0 for a domain of one piece, else 1, 2, ... per
+ * enclosed volume in the order their outer boundaries first appear among the facets (a
+ * sphere inside a box: 1 the shell, 2 the sphere).
  * Both hold `capacity` tets. `SM_ERR_BUFFER_TOO_SMALL` if `capacity < sm_num_tets(m)`;
  * nothing is written unless the call succeeds.
  *
@@ -443,7 +446,9 @@ sm_status sm_get_tets(const sm_mesher *m, uint32_t *tets, int32_t *regions, size
 
 /**
  * Copies the boundary triangles into `tris` (3 vertex ids each) and, if `markers` is not NULL,
- * each triangle's input facet marker into `markers`. Both hold `capacity` triangles.
+ * each triangle's input facet marker into `markers`. Both hold `capacity` triangles. An
+ * interface between two regions is among them once (its face is shared by one tet of each
+ * region), oriented out of one of the two (approximate mode: the one of lower region number).
  * `SM_ERR_BUFFER_TOO_SMALL` if `capacity < sm_num_boundary_faces(m)`; nothing is written
  * unless the call succeeds.
  *

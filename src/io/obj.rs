@@ -6,7 +6,12 @@
 //!   `i//n` (texture and normal indices are ignored). Indices are 1-based; a negative index
 //!   counts back from the last vertex defined so far (`-1` is the latest). Positive indices may
 //!   refer to vertices defined later in the file.
-//! - Ignored statements: `vt`, `vn`, `vp`, `o`, `g`, `s`, `mg`, `usemtl`, `mtllib`, `l`, `p`
+//! - `o name` and `g name ...`: the faces after them belong to that group (one group per
+//!   distinct name, in order of first appearance; faces before any are a group of their own).
+//!   When there are several groups and each is a closed surface (every edge of its faces used
+//!   by two of them), the groups are solids (`super::solids`): a face two of them list is one
+//!   interface facet, and each gets a region seed with attribute 1, 2, ... in group order.
+//! - Ignored statements: `vt`, `vn`, `vp`, `s`, `mg`, `usemtl`, `mtllib`, `l`, `p`
 //!   and the display attributes (`bevel`, `c_interp`, `d_interp`, `lod`, `maplib`, `usemap`,
 //!   `shadow_obj`, `trace_obj`).
 //! - `#` comments and blank lines anywhere.
@@ -17,6 +22,7 @@
 //! Not supported (a named error): free-form geometry (`curv`, `surf`, `cstype`, ...), line
 //! continuations (`\` at the end of a line).
 
+use super::solids::Solids;
 use super::text::{check_index, err_at, err_file, parse_i64, read_text, with_path, Lines};
 use super::{IoError, ReadOptions};
 use crate::plc::{Facet, PlcInput};
@@ -27,8 +33,6 @@ const IGNORED: &[&str] = &[
     "vt",
     "vn",
     "vp",
-    "o",
-    "g",
     "s",
     "mg",
     "usemtl",
@@ -63,10 +67,26 @@ pub fn parse_obj(text: &str, options: &ReadOptions) -> Result<PlcInput, IoError>
     let mut lines = Lines::new(text);
     let mut plc = PlcInput::default();
     let mut faces: Vec<Vec<Corner>> = Vec::new();
+    let mut groups: Vec<String> = vec![String::new()];
+    let (mut group, mut group_of) = (0u32, Vec::new());
     while let Some(mut r) = lines.next_opt() {
         let kw = r.word("a statement")?;
         match kw {
             "v" => plc.vertices.push(r.point()?),
+            "g" | "o" => {
+                let mut name = vec![];
+                while let Some(w) = r.word_opt() {
+                    name.push(w);
+                }
+                let name = name.join(" ");
+                group = match groups.iter().position(|g| *g == name) {
+                    Some(k) => k as u32,
+                    None => {
+                        groups.push(name);
+                        groups.len() as u32 - 1
+                    }
+                };
+            }
             "f" | "fo" => {
                 let fname = format!("face {}", faces.len() + 1);
                 let mut corners = Vec::new();
@@ -109,6 +129,7 @@ pub fn parse_obj(text: &str, options: &ReadOptions) -> Result<PlcInput, IoError>
                     ));
                 }
                 faces.push(corners);
+                group_of.push(group);
             }
             kw if IGNORED.contains(&kw) => {}
             "cstype" | "deg" | "bmat" | "step" | "curv" | "curv2" | "surf" | "parm" | "trim"
@@ -125,13 +146,36 @@ pub fn parse_obj(text: &str, options: &ReadOptions) -> Result<PlcInput, IoError>
     }
     let nv = plc.vertices.len();
     super::text::to_u32(nv, 1, "number of vertices")?;
-    plc.facets.reserve(faces.len());
+    let mut polygons = Vec::with_capacity(faces.len());
     for (i, corners) in faces.iter().enumerate() {
         let what = format!("face {}: vertex index", i + 1);
-        let poly = corners
-            .iter()
-            .map(|c| check_index(c.index, c.line, 1, nv, &what))
-            .collect::<Result<Vec<u32>, IoError>>()?;
+        polygons.push(
+            corners
+                .iter()
+                .map(|c| check_index(c.index, c.line, 1, nv, &what))
+                .collect::<Result<Vec<u32>, IoError>>()?,
+        );
+    }
+    let mut solids = Solids {
+        polygons,
+        solid_of: group_of,
+    };
+    let used: Vec<u32> = {
+        let mut u = solids.solid_of.clone();
+        u.sort_unstable();
+        u.dedup();
+        u
+    };
+    if used.len() > 1 && used.iter().all(|&g| solids.is_closed(g)) {
+        // Groups renumbered 0, 1, ... in order, leaving out the empty ones.
+        for g in &mut solids.solid_of {
+            *g = used.binary_search(g).unwrap_or(0) as u32;
+        }
+        plc.regions = solids.region_seeds(&plc.vertices, used.len());
+        solids.merge_shared();
+    }
+    plc.facets.reserve(solids.polygons.len());
+    for (i, poly) in solids.polygons.into_iter().enumerate() {
         plc.facets.push(Facet {
             polygons: vec![poly],
             marker: i32::try_from(i + 1).unwrap_or(i32::MAX),
@@ -187,6 +231,48 @@ mod tests {
         )
         .unwrap();
         assert_eq!(merged.facets.len(), 2, "the two z = 0 triangles merge");
+    }
+
+    /// Two unit cubes as two groups sharing the quad x = 1: one interface facet, regions 1
+    /// and 2 in group order, each seeded in its own cube. A group that is not closed (an open
+    /// box as one group) leaves the file one surface without regions.
+    #[test]
+    fn closed_groups_are_solids() {
+        let mut text = String::new();
+        for x in 0..3 {
+            for y in 0..2 {
+                for z in 0..2 {
+                    text += &format!("v {x} {y} {z}\n");
+                }
+            }
+        }
+        // Vertex (x, y, z) has index 4x + 2y + z + 1.
+        let v = |x: usize, y: usize, z: usize| 4 * x + 2 * y + z + 1;
+        let cube = |x0: usize| {
+            let x1 = x0 + 1;
+            [
+                [v(x0, 0, 0), v(x0, 0, 1), v(x0, 1, 1), v(x0, 1, 0)],
+                [v(x1, 0, 0), v(x1, 1, 0), v(x1, 1, 1), v(x1, 0, 1)],
+                [v(x0, 0, 0), v(x1, 0, 0), v(x1, 0, 1), v(x0, 0, 1)],
+                [v(x0, 1, 0), v(x0, 1, 1), v(x1, 1, 1), v(x1, 1, 0)],
+                [v(x0, 0, 0), v(x0, 1, 0), v(x1, 1, 0), v(x1, 0, 0)],
+                [v(x0, 0, 1), v(x1, 0, 1), v(x1, 1, 1), v(x0, 1, 1)],
+            ]
+            .map(|f| format!("f {} {} {} {}\n", f[0], f[1], f[2], f[3]))
+            .concat()
+        };
+        let two = format!("{text}g left\n{}g right\n{}", cube(0), cube(1));
+        let plc = parse_obj(&two, &ReadOptions::default()).unwrap();
+        assert_eq!(plc.facets.len(), 11, "the common quad once");
+        let checked = crate::plc::validate(&plc).unwrap();
+        assert_eq!(checked.region_attributes(), vec![1, 2]);
+        assert!(plc.regions[0].point.x < 1.0 && plc.regions[1].point.x > 1.0);
+        let open: String = cube(0).lines().skip(1).map(|l| format!("{l}\n")).collect();
+        let one = format!("{text}g open\n{open}g right\n{}", cube(1));
+        assert!(parse_obj(&one, &ReadOptions::default())
+            .unwrap()
+            .regions
+            .is_empty());
     }
 
     fn expect_err(text: &str, line: usize, needle: &str) {

@@ -1,5 +1,6 @@
-//! Several solids in one surface file (the `solid` blocks of an ASCII STL): a triangle that
-//! two solids share (the same three vertices, listed once by each) is one interface facet,
+//! Several solids in one surface file (the `solid` blocks of an ASCII STL, the groups of an
+//! OBJ): a polygon that two solids share (the same vertices, listed once by each) is one
+//! interface facet,
 //! and each solid gets a region seed with its 1-based place in the file as attribute, so
 //! that the regions are labelled the way the file names them.
 
@@ -7,20 +8,38 @@ use crate::plc::Region;
 use glam::DVec3;
 use rustc_hash::FxHashMap;
 
-/// The triangles of a soup, each with the solid (0-based, file order) it was read in.
+/// The polygons of a soup (triangles, or any polygon fanned from its first corner in the
+/// geometric tests), each with the solid (0-based, file order) it was read in.
 pub struct Solids {
-    pub triangles: Vec<Vec<u32>>,
+    pub polygons: Vec<Vec<u32>>,
     pub solid_of: Vec<u32>,
 }
 
 impl Solids {
+    /// Whether solid `s` is a closed surface: every edge of its polygons used by two of them.
+    pub fn is_closed(&self, s: u32) -> bool {
+        let mut count: FxHashMap<[u32; 2], u32> = FxHashMap::default();
+        for (p, _) in self
+            .polygons
+            .iter()
+            .zip(&self.solid_of)
+            .filter(|x| *x.1 == s)
+        {
+            for (i, &a) in p.iter().enumerate() {
+                let b = p[(i + 1) % p.len()];
+                *count.entry([a.min(b), a.max(b)]).or_default() += 1;
+            }
+        }
+        count.values().all(|&n| n == 2)
+    }
+
     /// Drops every triangle that an earlier solid already listed with the same vertices (an
     /// interface: one facet, two regions). Triangles repeated within one solid are kept, for
     /// the validator to name.
     pub fn merge_shared(&mut self) {
         let mut first: FxHashMap<Vec<u32>, u32> = FxHashMap::default();
-        let mut keep = vec![true; self.triangles.len()];
-        for (i, t) in self.triangles.iter().enumerate() {
+        let mut keep = vec![true; self.polygons.len()];
+        for (i, t) in self.polygons.iter().enumerate() {
             let mut key = t.clone();
             key.sort_unstable();
             match first.get(&key) {
@@ -32,7 +51,7 @@ impl Solids {
             }
         }
         let mut k = keep.iter();
-        self.triangles.retain(|_| *k.next().unwrap_or(&true));
+        self.polygons.retain(|_| *k.next().unwrap_or(&true));
         let mut k = keep.iter();
         self.solid_of.retain(|_| *k.next().unwrap_or(&true));
     }
@@ -44,40 +63,33 @@ impl Solids {
     /// as read (before `merge_shared`). A solid whose ray meets nothing (not closed) gets no
     /// seed; the validator places seeds exactly.
     pub fn region_seeds(&self, vertices: &[DVec3], n_solids: usize) -> Vec<Region> {
-        let corners = |t: &[u32]| [t[0], t[1], t[2]].map(|v| vertices[v as usize]);
+        // Every polygon as the triangles of its fan.
+        let fan = |p: &[u32]| -> Vec<[DVec3; 3]> {
+            (1..p.len() - 1)
+                .map(|i| [p[0], p[i], p[i + 1]].map(|v| vertices[v as usize]))
+                .collect()
+        };
+        let all: Vec<[DVec3; 3]> = self.polygons.iter().flat_map(|p| fan(p)).collect();
         let mut seeds = vec![];
         for s in 0..n_solids as u32 {
-            let own: Vec<&Vec<u32>> = self
-                .triangles
+            let own: Vec<[DVec3; 3]> = self
+                .polygons
                 .iter()
                 .zip(&self.solid_of)
                 .filter(|(_, &k)| k == s)
-                .map(|(t, _)| t)
+                .flat_map(|(p, _)| fan(p))
                 .collect();
-            let volume: f64 = own
-                .iter()
-                .map(|t| {
-                    let [a, b, c] = corners(t);
-                    a.dot(b.cross(c))
-                })
-                .sum();
-            let Some(largest) = own.iter().max_by(|x, y| {
-                let area = |t: &[u32]| {
-                    let [a, b, c] = corners(t);
-                    (b - a).cross(c - a).length()
-                };
-                area(x).total_cmp(&area(y))
-            }) else {
+            let volume: f64 = own.iter().map(|[a, b, c]| a.dot(b.cross(*c))).sum();
+            let area = |[a, b, c]: &[DVec3; 3]| (*b - *a).cross(*c - *a).length();
+            let Some(&[a, b, c]) = own.iter().max_by(|x, y| area(x).total_cmp(&area(y))) else {
                 continue;
             };
-            let [a, b, c] = corners(largest);
             let normal = (b - a).cross(c - a).normalize_or_zero();
             let inwards = if volume >= 0.0 { -normal } else { normal };
             let from = (a + b + c) / 3.0;
-            let nearest = self
-                .triangles
+            let nearest = all
                 .iter()
-                .filter_map(|t| ray_hit(from, inwards, corners(t)))
+                .filter_map(|&t| ray_hit(from, inwards, t))
                 .filter(|&d| d > 0.0)
                 .fold(f64::INFINITY, f64::min);
             if nearest.is_finite() {

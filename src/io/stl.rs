@@ -57,7 +57,7 @@ pub fn parse_stl(bytes: &[u8], options: &ReadOptions) -> Result<PlcInput, IoErro
         parse_ascii(&text, &mut soup)?;
     }
     let mut solids = Solids {
-        triangles: soup.triangles,
+        polygons: soup.triangles,
         solid_of: soup.solid_of,
     };
     let mut regions = vec![];
@@ -71,7 +71,7 @@ pub fn parse_stl(bytes: &[u8], options: &ReadOptions) -> Result<PlcInput, IoErro
         ..PlcInput::default()
     };
     plc.facets = solids
-        .triangles
+        .polygons
         .into_iter()
         .enumerate()
         .map(|(i, t)| Facet {
