@@ -482,8 +482,12 @@ impl<'a> SurfaceMesher<'a> {
                 return Err(e);
             }
             let (faces, problems) = self.extract();
-            let far = if problems.is_empty() && self.vol.is_none() && stop_reason.is_none() {
-                self.far_from_input(&faces)
+            let far = if problems.is_empty() && stop_reason.is_none() {
+                let mut far = self.far_from_input(&faces);
+                if far.is_empty() {
+                    far = self.far_from_surface(&faces);
+                }
+                far
             } else {
                 vec![]
             };
@@ -963,6 +967,49 @@ impl<'a> SurfaceMesher<'a> {
             })
             .collect();
         // One sample per face: the farthest (ties by position, for determinism).
+        far.sort_unstable_by(|a, b| {
+            a.0.cmp(&b.0).then(b.1.total_cmp(&a.1)).then(
+                a.2.to_array()
+                    .partial_cmp(&b.2.to_array())
+                    .unwrap_or(Ordering::Equal),
+            )
+        });
+        far.dedup_by_key(|x| x.0);
+        far.into_iter().map(|((t, i), _, p)| (t, i, p)).collect()
+    }
+
+    /// The other way: the boundary faces holding a sample of the report's (the boundary's
+    /// `measure::hausdorff_samples`) farther than the bound from the input, away from small
+    /// corners, each with its farthest such sample (the input point nearest to it mends the
+    /// face). The facet criteria measure at the surface centre and the centroid; a flat face
+    /// over a fold of the input can stray farther elsewhere.
+    fn far_from_surface(&self, faces: &[FaceRef]) -> Vec<(u32, usize, DVec3)> {
+        let triangles = faces
+            .iter()
+            .map(|&(t, i)| FACE[i].map(|k| self.dt.tet(t)[k]))
+            .collect();
+        let extracted = InputSurface::from_triangles(self.dt.points().to_vec(), triangles);
+        let mut hint = None;
+        let far_samples: Vec<DVec3> = super::measure::hausdorff_samples(&extracted)
+            .into_iter()
+            .filter(|&p| {
+                self.oracle
+                    .distance_beyond_hinted(p, self.criteria.bound, &mut hint)
+                    .is_some()
+            })
+            .filter(|&p| !self.near_small_corner(p))
+            .collect();
+        if far_samples.is_empty() {
+            return vec![];
+        }
+        let near = SurfaceOracle::for_distances(&extracted);
+        let mut far: Vec<(FaceRef, f64, DVec3)> = far_samples
+            .into_iter()
+            .filter_map(|p| {
+                let d = self.oracle.closest(p)?.distance;
+                near.closest(p).map(|c| (faces[c.triangle as usize], d, p))
+            })
+            .collect();
         far.sort_unstable_by(|a, b| {
             a.0.cmp(&b.0).then(b.1.total_cmp(&a.1)).then(
                 a.2.to_array()

@@ -9,7 +9,7 @@
 
 use slivermesh::surface::oracle::closest_on_triangle;
 use slivermesh::DVec3;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::f64::consts::PI;
 
 /// One closed, outward-oriented triangle surface (or several, when appended).
@@ -277,11 +277,28 @@ impl Shape {
         }
     }
 
-    /// Every body's triangles in one surface.
+    /// Every body's triangles in one surface, vertices at equal positions merged; a triangle
+    /// two bodies share (an interface, listed the other way round by the second) once.
     pub fn all(&self) -> Surface {
         let mut s = Surface::default();
+        let mut ids: HashMap<[u64; 3], u32> = HashMap::new();
+        let mut seen: HashSet<[u32; 3]> = HashSet::new();
         for b in &self.solids {
-            s.append(b);
+            for t in &b.triangles {
+                let t = t.map(|v| {
+                    let p = b.vertices[v as usize];
+                    *ids.entry(p.to_array().map(f64::to_bits))
+                        .or_insert_with(|| {
+                            s.vertices.push(p);
+                            s.vertices.len() as u32 - 1
+                        })
+                });
+                let mut key = t;
+                key.sort_unstable();
+                if seen.insert(key) {
+                    s.triangles.push(t);
+                }
+            }
         }
         s
     }
@@ -311,6 +328,7 @@ pub fn single_body() -> Vec<Shape> {
 pub fn multi_body() -> Vec<Shape> {
     vec![
         two_bodies(),
+        half_balls(),
         sphere_in_box(),
         two_touching_blocks_stl(),
         three_regions_edge(),
@@ -496,6 +514,102 @@ pub fn sphere_in_box() -> Shape {
         stl: false,
         analytic_volume: Some((27.0, 1e-12)),
     }
+}
+
+/// A ball cut by the plane z = 0 into two regions, in one .off: the two hemispheres and the
+/// disk between them (16 rings a side, 64 around), which meets the sphere along the equator
+/// (three faces at every equator edge). Solids: the upper and the lower half, each closed by
+/// the disk.
+pub fn half_balls() -> Shape {
+    let (around, rings) = (64usize, 16usize);
+    let mut vertices = vec![];
+    let mut ring = |r: f64, z: f64| -> Vec<u32> {
+        (0..around)
+            .map(|k| {
+                let a = 2.0 * PI * k as f64 / around as f64;
+                vertices.push(DVec3::new(r * a.cos(), r * a.sin(), z));
+                vertices.len() as u32 - 1
+            })
+            .collect()
+    };
+    // Rows from the equator inwards, each a ring; the last row closes at a centre vertex.
+    let equator = ring(1.0, 0.0);
+    let mut rows_of = |shape: &dyn Fn(usize) -> (f64, f64)| -> Vec<Vec<u32>> {
+        let mut rows = vec![equator.clone()];
+        rows.extend((1..rings).map(|i| {
+            let (r, z) = shape(i);
+            ring(r, z)
+        }));
+        rows
+    };
+    let angle = |i: usize| PI / 2.0 * i as f64 / rings as f64;
+    let top = rows_of(&|i| (angle(i).cos(), angle(i).sin()));
+    let bottom = rows_of(&|i| (angle(i).cos(), -angle(i).sin()));
+    let disk = rows_of(&|i| (1.0 - i as f64 / rings as f64, 0.0));
+    let mut centre = |p: DVec3| {
+        vertices.push(p);
+        vertices.len() as u32 - 1
+    };
+    let centres = [centre(DVec3::Z), centre(-DVec3::Z), centre(DVec3::ZERO)];
+    // Triangles of the rows and their centre, counter-clockwise seen from +z.
+    let fan = |rows: &[Vec<u32>], c: u32| -> Vec<[u32; 3]> {
+        let mut t = vec![];
+        for w in rows.windows(2) {
+            for k in 0..around {
+                let k1 = (k + 1) % around;
+                t.push([w[0][k], w[0][k1], w[1][k1]]);
+                t.push([w[0][k], w[1][k1], w[1][k]]);
+            }
+        }
+        let last = rows.last().unwrap();
+        t.extend((0..around).map(|k| [last[k], last[(k + 1) % around], c]));
+        t
+    };
+    let flip =
+        |t: Vec<[u32; 3]>| -> Vec<[u32; 3]> { t.into_iter().map(|[a, b, c]| [a, c, b]).collect() };
+    let (up, down, lid) = (
+        fan(&top, centres[0]),
+        flip(fan(&bottom, centres[1])),
+        fan(&disk, centres[2]),
+    );
+    let solid = |a: &[[u32; 3]], b: &[[u32; 3]]| {
+        compact(Surface {
+            vertices: vertices.clone(),
+            triangles: a.iter().chain(b).copied().collect(),
+        })
+    };
+    let upper = solid(&up, &flip(lid.clone()));
+    let lower = solid(&down, &lid);
+    let interface_area = compact(Surface {
+        vertices: vertices.clone(),
+        triangles: lid,
+    })
+    .area();
+    Shape {
+        name: "half_balls",
+        part_volumes: vec![upper.volume(), lower.volume()],
+        solids: vec![upper, lower],
+        stl: false,
+        analytic_volume: Some((4.0 / 3.0 * PI, 1e-2)),
+        interface_area,
+    }
+}
+
+/// `s` without the vertices no triangle uses, renumbered in order.
+fn compact(s: Surface) -> Surface {
+    let mut id = vec![u32::MAX; s.vertices.len()];
+    let mut out = Surface::default();
+    for t in &s.triangles {
+        let t = t.map(|v| {
+            if id[v as usize] == u32::MAX {
+                id[v as usize] = out.vertices.len() as u32;
+                out.vertices.push(s.vertices[v as usize]);
+            }
+            id[v as usize]
+        });
+        out.triangles.push(t);
+    }
+    out
 }
 
 /// Two unit cubes sharing the face x = 1, as two STL solids: the common face appears in both,
