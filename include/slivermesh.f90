@@ -48,6 +48,13 @@ module slivermesh
     integer(c_int32_t) :: complete
   end type sm_quality
 
+  !> One region of the last run's mesh (struct sm_region).
+  type, bind(C), public :: sm_region
+    integer(c_int32_t) :: attribute
+    integer(c_size_t) :: tets
+    real(c_double) :: volume, input_volume, relative_volume_difference
+  end type sm_region
+
   !> Shapes of the callbacks (declare yours like these, with bind(C), and pass c_funloc(f)).
   abstract interface
     !> Target element size at (x, y, z): finite and > 0, anything else fails sm_refine.
@@ -240,6 +247,23 @@ module slivermesh
       integer(c_int32_t) :: s
     end function sm_get_quality
 
+    function sm_num_regions(m) bind(C, name="sm_num_regions") result(n)
+      import :: c_ptr, c_size_t
+      type(c_ptr), value :: m
+      integer(c_size_t) :: n
+    end function sm_num_regions
+
+    !> regions(capacity), sorted by attribute; the two areas may be omitted (NULL).
+    function sm_get_regions(m, regions, capacity, interface_area, input_interface_area) &
+        bind(C, name="sm_get_regions") result(s)
+      import :: c_ptr, c_size_t, c_double, c_int32_t, sm_region
+      type(c_ptr), value :: m
+      type(sm_region), intent(inout) :: regions(*)
+      integer(c_size_t), value :: capacity
+      real(c_double), intent(inout), optional :: interface_area, input_interface_area
+      integer(c_int32_t) :: s
+    end function sm_get_regions
+
     function sm_write_c(m, path) bind(C, name="sm_write") result(s)
       import :: c_ptr, c_char, c_int32_t
       type(c_ptr), value :: m
@@ -281,7 +305,8 @@ module slivermesh
             sm_add_hole, sm_add_region, sm_set_spacing_cb, sm_set_spacing_batch_cb, &
             sm_set_spacing_const, sm_set_param_c, sm_get_param_c, sm_set_progress_cb, &
             sm_refine, sm_num_vertices, sm_num_tets, sm_num_boundary_faces, sm_get_vertices, &
-            sm_get_tets, sm_get_boundary_faces, sm_get_quality, sm_write_c, sm_last_error_c, &
+            sm_get_tets, sm_get_boundary_faces, sm_get_quality, sm_num_regions, sm_get_regions, &
+            sm_write_c, sm_last_error_c, &
             sm_stop_reason_c, sm_status_str_c, sm_version_c
   public :: sm_set_param, sm_get_param, sm_write, sm_last_error, sm_stop_reason, &
             sm_status_str, sm_version

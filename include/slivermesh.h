@@ -140,6 +140,26 @@ typedef struct {
 } sm_quality;
 
 /**
+ * One region of the last run's mesh (all tets of one attribute) against the input's.
+ */
+typedef struct {
+    /**
+     * The attribute `sm_get_tets` gives its tets.
+     */
+    int32_t attribute;
+    size_t tets;
+    double volume;
+    /**
+     * The input region's volume (0 when the input has no region of this attribute).
+     */
+    double input_volume;
+    /**
+     * (volume - input_volume) / input_volume.
+     */
+    double relative_volume_difference;
+} sm_region;
+
+/**
  * Success.
  */
 #define SM_OK 0
@@ -489,6 +509,31 @@ const char *sm_stop_reason(const sm_mesher *m);
  * `m` is NULL or a live handle; `out` is NULL or points to a writable `sm_quality`.
  */
 sm_status sm_get_quality(const sm_mesher *m, sm_quality *out);
+
+/**
+ * Number of regions (distinct tet attributes) of the last run's mesh; 0 before a successful
+ * `sm_refine`.
+ *
+ * # Safety
+ * `m` is NULL or a live handle.
+ */
+size_t sm_num_regions(const sm_mesher *m);
+
+/**
+ * Copies each region's figures into `regions` (sorted by attribute), and the area of the faces
+ * between tets of different regions, and the input's, into `*interface_area` and
+ * `*input_interface_area` when they are not NULL. `SM_ERR_BUFFER_TOO_SMALL` if
+ * `capacity < sm_num_regions(m)`; nothing is written unless the call succeeds.
+ *
+ * # Safety
+ * `m` is NULL or a live handle; `regions` is NULL or points to `capacity` writable
+ * `sm_region`s; the areas are NULL or point to writable doubles.
+ */
+sm_status sm_get_regions(const sm_mesher *m,
+                         sm_region *regions,
+                         size_t capacity,
+                         double *interface_area,
+                         double *input_interface_area);
 
 #ifdef __cplusplus
 }  // extern "C"

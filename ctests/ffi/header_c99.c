@@ -7,6 +7,7 @@
 #if SIZE_MAX == UINT64_MAX
 /* The Fortran module (include/slivermesh.f90) and the Rust tests check the same size. */
 typedef char sm_quality_is_168_bytes[sizeof(sm_quality) == 168 ? 1 : -1];
+typedef char sm_region_is_40_bytes[sizeof(sm_region) == 40 ? 1 : -1];
 #endif
 
 static double size_fn(double x, double y, double z, void *user_data) {
@@ -41,6 +42,11 @@ int main(void) {
     s |= sm_set_progress_cb(m, p, NULL);
     q.n_tets = sm_num_tets(cm);
     q.complete = 0;
+    /* Before sm_refine: no regions, and asking for them is an error naming it. */
+    if (sm_num_regions(cm) != 0 ||
+        sm_get_regions(cm, (sm_region *)NULL, 0, (double *)NULL, (double *)NULL) != SM_ERR_NOT_REFINED) {
+        return 1;
+    }
     printf("slivermesh %s (C99), status %d, %zu tets, complete %d\n", sm_version(), (int)s,
            q.n_tets, (int)q.complete);
     sm_destroy(m);

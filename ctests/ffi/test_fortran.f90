@@ -1,7 +1,7 @@
 !> The Fortran module against the library: string wrappers, parameters, status texts, Fortran
 !> callbacks (a spacing returning 0, a batched spacing returning NaN, a progress callback that
 !> cancels), outputs before sm_refine with an omitted optional argument, then a real mesh: the
-!> sm_quality layout matches C, buffer too small, optional markers omitted. The example
+!> sm_quality and sm_region layouts match C, buffer too small, optional markers omitted. The example
 !> examples/fortran/cube.f90 (test ffi_example_fortran) meshes and writes a .vtu.
 module test_callbacks
   use, intrinsic :: iso_c_binding, only: c_double, c_ptr, c_size_t, c_int32_t
@@ -40,6 +40,8 @@ program test_fortran
   implicit none
   type(c_ptr) :: m
   type(sm_quality) :: q
+  type(sm_region) :: r(1)
+  real(c_double) :: area
   real(c_double) :: v, xyz(3, 8)
   integer(c_int32_t), parameter :: faces(4, 6) = reshape([ &
     0, 2, 3, 1,  4, 5, 7, 6,  0, 1, 5, 4,  2, 6, 7, 3,  0, 4, 6, 2,  1, 3, 7, 5], [4, 6])
@@ -107,6 +109,14 @@ program test_fortran
     call expect(sm_get_boundary_faces(m, tris, capacity=size(tris, 2, c_size_t)) == SM_OK, &
                 'boundary faces, markers omitted')
     call expect(minval(tris) >= 0 .and. maxval(tris) < sm_num_vertices(m), 'boundary ids')
+    ! One region (attribute 0), the whole cube; no interfaces.
+    call expect(c_sizeof(r) == 40_c_size_t, 'sizeof(sm_region) == 40 as in C')
+    call expect(sm_num_regions(m) == 1, 'one region')
+    call expect(sm_get_regions(m, r, 1_c_size_t, area) == SM_OK, 'regions, input area omitted')
+    call expect(r(1)%attribute == 0 .and. r(1)%tets == sm_num_tets(m), 'region tets')
+    call expect(abs(r(1)%volume - 1) < 1d-9 .and. abs(r(1)%input_volume - 1) < 1d-12, &
+                'region volume')
+    call expect(area == 0, 'no interface')
   end if
   call sm_destroy(m)
   call sm_destroy(c_null_ptr)

@@ -1,7 +1,8 @@
 //! `sm_quality`: the figures of the last run's report.
 
-use super::guard::handle_call;
+use super::guard::{handle_call, handle_query};
 use super::mesher::sm_mesher;
+use super::slices::output;
 use super::status::*;
 use crate::refine::Report;
 
@@ -82,6 +83,79 @@ pub unsafe extern "C" fn sm_get_quality(m: *const sm_mesher, out: *mut sm_qualit
         let q = sm_quality::from(st.mesher.report()?);
         // SAFETY: `out` is non-null and writable (contract above).
         unsafe { out.write(q) };
+        Ok(())
+    })
+}
+
+/// One region of the last run's mesh (all tets of one attribute) against the input's.
+#[allow(non_camel_case_types)]
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct sm_region {
+    /// The attribute `sm_get_tets` gives its tets.
+    pub attribute: i32,
+    pub tets: usize,
+    pub volume: f64,
+    /// The input region's volume (0 when the input has no region of this attribute).
+    pub input_volume: f64,
+    /// (volume - input_volume) / input_volume.
+    pub relative_volume_difference: f64,
+}
+
+/// Number of regions (distinct tet attributes) of the last run's mesh; 0 before a successful
+/// `sm_refine`.
+///
+/// # Safety
+/// `m` is NULL or a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn sm_num_regions(m: *const sm_mesher) -> usize {
+    // SAFETY: `m` is NULL or a live handle (contract above).
+    let handle = unsafe { m.as_ref() };
+    handle_query(handle, "sm_num_regions", 0, |st| {
+        st.mesher.report().map_or(0, |r| r.regions.len())
+    })
+}
+
+/// Copies each region's figures into `regions` (sorted by attribute), and the area of the faces
+/// between tets of different regions, and the input's, into `*interface_area` and
+/// `*input_interface_area` when they are not NULL. `SM_ERR_BUFFER_TOO_SMALL` if
+/// `capacity < sm_num_regions(m)`; nothing is written unless the call succeeds.
+///
+/// # Safety
+/// `m` is NULL or a live handle; `regions` is NULL or points to `capacity` writable
+/// `sm_region`s; the areas are NULL or point to writable doubles.
+#[no_mangle]
+pub unsafe extern "C" fn sm_get_regions(
+    m: *const sm_mesher,
+    regions: *mut sm_region,
+    capacity: usize,
+    interface_area: *mut f64,
+    input_interface_area: *mut f64,
+) -> sm_status {
+    // SAFETY: `m` is NULL or a live handle (contract above).
+    let handle = unsafe { m.as_ref() };
+    handle_call(handle, "sm_get_regions", |st| {
+        let report = st.mesher.report()?;
+        // SAFETY: `regions` is NULL or holds `capacity` items (contract above).
+        let out = unsafe { output("regions", regions, capacity, report.regions.len(), 1) }?;
+        for (o, r) in out.iter_mut().zip(&report.regions) {
+            *o = sm_region {
+                attribute: r.attribute,
+                tets: r.tets,
+                volume: r.volume,
+                input_volume: r.input_volume,
+                relative_volume_difference: r.relative_volume_difference,
+            };
+        }
+        for (p, v) in [
+            (interface_area, report.interface_area),
+            (input_interface_area, report.input_interface_area),
+        ] {
+            if !p.is_null() {
+                // SAFETY: non-null and writable (contract above).
+                unsafe { p.write(v) };
+            }
+        }
         Ok(())
     })
 }

@@ -570,3 +570,60 @@ fn cube_through_the_c_abi() {
         assert!((volume - 1.0).abs() < 1e-9, "{volume}");
     }
 }
+
+/// Two regions through the C ABI: the cube split by the facet x = 0.5 (two region seeds), each
+/// region's figures and the interface area from `sm_get_regions`.
+#[test]
+fn regions_through_the_c_abi() {
+    let h = new();
+    let mut xyz = CUBE_XYZ.to_vec();
+    // The mid-plane's corners: ids 8-11.
+    for (y, z) in [(0., 0.), (1., 0.), (1., 1.), (0., 1.)] {
+        xyz.extend([0.5, y, z]);
+    }
+    // SAFETY: live handle, arrays of the stated sizes, buffers sized from the counts.
+    unsafe {
+        assert_eq!(sm_add_vertices(h.0, xyz.as_ptr(), 12), SM_OK);
+        // x = 0 and x = 1 sides whole; the four others split at x = 0.5.
+        let faces: [&[u32]; 11] = [
+            &[0, 4, 6, 2],
+            &[1, 3, 7, 5],
+            &[8, 9, 10, 11],
+            &[0, 8, 11, 4],
+            &[8, 1, 5, 11],
+            &[2, 6, 10, 9],
+            &[9, 10, 7, 3],
+            &[0, 2, 9, 8],
+            &[8, 9, 3, 1],
+            &[4, 11, 10, 6],
+            &[11, 5, 7, 10],
+        ];
+        for (k, f) in faces.iter().enumerate() {
+            assert_eq!(sm_add_facet(h.0, f.as_ptr(), f.len(), k as i32 + 1), SM_OK);
+        }
+        assert_eq!(sm_add_region(h.0, 0.25, 0.5, 0.5, 7, -1.0), SM_OK);
+        assert_eq!(sm_add_region(h.0, 0.75, 0.5, 0.5, 9, -1.0), SM_OK);
+        assert_eq!(sm_num_regions(h.0), 0, "before refining");
+        assert_eq!(sm_set_spacing_const(h.0, 0.3), SM_OK);
+        assert_eq!(sm_refine(h.0), SM_OK, "{}", last_error(&h));
+        assert_eq!(sm_num_regions(h.0), 2);
+        let mut regions = [sm_region::default(); 2];
+        assert_eq!(
+            sm_get_regions(h.0, regions.as_mut_ptr(), 1, null_mut(), null_mut()),
+            SM_ERR_BUFFER_TOO_SMALL
+        );
+        let (mut area, mut input_area) = (0.0, 0.0);
+        assert_eq!(
+            sm_get_regions(h.0, regions.as_mut_ptr(), 2, &mut area, &mut input_area),
+            SM_OK
+        );
+        assert_eq!([regions[0].attribute, regions[1].attribute], [7, 9]);
+        let nt = sm_num_tets(h.0);
+        assert_eq!(regions[0].tets + regions[1].tets, nt);
+        for r in regions {
+            assert!((r.volume - 0.5).abs() < 1e-9 && (r.input_volume - 0.5).abs() < 1e-12);
+            assert!(r.relative_volume_difference.abs() < 1e-9);
+        }
+        assert!((area - 1.0).abs() < 1e-9 && (input_area - 1.0).abs() < 1e-12);
+    }
+}
