@@ -79,6 +79,9 @@ impl Improver<'_> {
         if make.is_empty() || !make.iter().all(|&(nt, _)| w.positive(nt)) {
             return None;
         }
+        if !self.keeps_rho(&w.star[v as usize], make.iter().map(|(nt, _)| w.points(nt))) {
+            return None;
+        }
         Some(Deletion {
             v,
             kill: w.star[v as usize].clone(),

@@ -365,7 +365,9 @@ impl Improver<'_> {
         let mut best: Option<Plan> = None;
         let mut consider = |p: Option<Plan>| {
             if let Some(p) = p {
-                if best.as_ref().is_none_or(|b| p.new_min > b.new_min) {
+                if best.as_ref().is_none_or(|b| p.new_min > b.new_min)
+                    && self.keeps_rho(&p.kill, p.make.iter().map(|t| self.w.points(t)))
+                {
                     best = Some(p);
                 }
             }

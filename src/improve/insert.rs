@@ -65,6 +65,11 @@ impl Improver<'_> {
                     let p = t.map(|v| if v == NEW { at } else { w.p(v) });
                     crate::geom::orient3d(p[0], p[1], p[2], p[3]) > 0.0
                 })
+                && self.keeps_rho(
+                    &cavity,
+                    make.iter()
+                        .map(|t| t.map(|v| if v == NEW { at } else { w.p(v) })),
+                )
             {
                 best = Some(Insertion {
                     at,

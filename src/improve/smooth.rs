@@ -200,6 +200,13 @@ impl Improver<'_> {
         if qx <= q0 + SMOOTH_GAIN || qx.is_nan() || !self.valid_move(&star, v, x) {
             return false;
         }
+        let keeps = star.iter().zip(&ids).all(|(tv, &t)| {
+            let moved = tv.map(|u| if u == v { x } else { self.w.p(u) });
+            self.keeps_rho(&[t], [moved])
+        });
+        if !keeps {
+            return false;
+        }
         self.w.pos[v as usize] = x;
         for (&t, tv) in ids.iter().zip(&star) {
             self.w.q[t as usize] = q_at(&self.w.pos, self.w.objective, tv, v, x);

@@ -41,6 +41,11 @@ pub(crate) struct Work {
     pub objective: Objective,
     /// Vertices deletion removed (no tet uses them; the output drops them).
     pub deleted: Vec<u32>,
+    /// The radius-edge bound no change may break (`Options::keep_rho`; infinite: none).
+    pub rho_limit: f64,
+    /// Vertices of the tets that exceeded `rho_limit` on entry: where refinement did not meet
+    /// the bound (next to small input angles), changes touching them are not held to it.
+    pub rho_exempt: Vec<bool>,
 }
 
 /// Face `i` of tet `tv` (the one opposite its vertex `i`).
@@ -96,6 +101,8 @@ impl Work {
             q: Vec::with_capacity(mesh.tets.len()),
             objective,
             deleted: vec![],
+            rho_limit: f64::INFINITY,
+            rho_exempt: vec![],
         };
         let mut degree = vec![0u32; n];
         mesh.tets
@@ -123,6 +130,58 @@ impl Work {
     }
 
     /// The least objective of tets `tets`.
+    /// Radius-edge ratio of a tet with these corners.
+    pub fn rho_at(p: [DVec3; 4]) -> f64 {
+        crate::geom::radius_edge_ratio(p[0], p[1], p[2], p[3])
+    }
+
+    /// Sets the radius-edge bound and marks the vertices where the mesh exceeds it now.
+    pub fn set_rho_limit(&mut self, limit: f64) {
+        self.rho_limit = limit;
+        self.rho_exempt = vec![false; self.pos.len()];
+        if limit.is_infinite() {
+            return;
+        }
+        for t in 0..self.tets.len() {
+            let tv = self.tets[t];
+            if self.alive[t] && Self::rho_at(self.points(&tv)) > limit {
+                tv.iter().for_each(|&v| self.rho_exempt[v as usize] = true);
+            }
+        }
+    }
+
+    /// Whether tets with corners `new` may replace the tets `old` under the radius-edge
+    /// bound: none of them above `rho_limit` unless an old tet was above it already, and then
+    /// none above the largest old one. Always true without a bound, and for changes touching
+    /// a vertex where the mesh exceeded the bound on entry (`rho_exempt`).
+    pub fn keeps_rho(&self, old: &[u32], new: impl IntoIterator<Item = [DVec3; 4]>) -> bool {
+        if self.rho_limit.is_infinite() {
+            return true;
+        }
+        let exempt = |t: &u32| {
+            self.tets[*t as usize]
+                .iter()
+                .any(|&v| self.rho_exempt.get(v as usize).copied().unwrap_or(false))
+        };
+        if old.iter().any(exempt) {
+            return true;
+        }
+        let mut cap = self.rho_limit;
+        // Most changes create no tet over the bound: the old tets are measured only then.
+        let over: Vec<f64> = new
+            .into_iter()
+            .map(Self::rho_at)
+            .filter(|&r| r > cap)
+            .collect();
+        if over.is_empty() {
+            return true;
+        }
+        for &t in old {
+            cap = cap.max(Self::rho_at(self.points(&self.tets[t as usize])));
+        }
+        over.iter().all(|&r| r <= cap)
+    }
+
     pub fn worst_q(&self, tets: &[u32]) -> f64 {
         tets.iter()
             .map(|&t| self.q[t as usize])

@@ -247,7 +247,7 @@ impl Report {
         row(
             "time improvement (s)",
             format!(
-                "{:.3} (flips {}, moves {}, insertions {}, deletions {}{})",
+                "{:.3} (flips {}, moves {}, insertions {}, deletions {}, rho0 vetoes {}{})",
                 self.seconds_improvement,
                 self.improvement.edge_removals
                     + self.improvement.face_removals
@@ -256,6 +256,7 @@ impl Report {
                 self.improvement.smoothed,
                 self.improvement.insertions,
                 self.improvement.deletions,
+                self.improvement.rho_vetoes,
                 if self.delaunay { ", Delaunay" } else { "" }
             ),
         );
