@@ -94,6 +94,9 @@ pub struct Stats {
     /// tet would have exceeded the radius-edge bound (`Options::keep_rho`): where the dihedral
     /// target gave way to rho0.
     pub rho_vetoes: usize,
+    /// Changes made although a new tet exceeds the bound, next to where refinement left it
+    /// unmet (small input angles): where rho0 gave way to the dihedral target.
+    pub rho_yields: usize,
     pub seconds: f64,
     /// Of which planning topological changes, and smoothing.
     pub seconds_plans: f64,
@@ -124,6 +127,7 @@ pub(crate) struct Improver<'s> {
     /// Changes refused for the radius-edge bound (`Stats::rho_vetoes`; counted by planners
     /// that only read the mesh).
     rho_vetoes: std::cell::Cell<usize>,
+    rho_yields: std::cell::Cell<usize>,
 }
 
 /// How the boundary vertices of an approximated surface may move (approximate mode): within
@@ -195,6 +199,7 @@ pub fn improve_with(
         slide,
         stats: Stats::default(),
         rho_vetoes: Default::default(),
+        rho_yields: Default::default(),
     };
     im.stats.degenerate_before = (0..im.w.tets.len())
         .filter(|&t| im.w.q[t] < SURELY_POSITIVE && !im.w.positive(im.w.tets[t]))
@@ -203,18 +208,26 @@ pub fn improve_with(
         im.run(opts);
     }
     im.stats.rho_vetoes = im.rho_vetoes.get();
+    im.stats.rho_yields = im.rho_yields.get();
     im.stats.seconds = start.elapsed().as_secs_f64();
     (im.w.to_mesh(), im.stats)
 }
 
 impl Improver<'_> {
-    /// `Work::keeps_rho`, counting the refusals.
+    /// `Work::keeps_rho` as a yes or no, counting the refusals and where the bound gave way.
     fn keeps_rho(&self, old: &[u32], new: impl IntoIterator<Item = [DVec3; 4]>) -> bool {
-        let keeps = self.w.keeps_rho(old, new);
-        if !keeps {
-            self.rho_vetoes.set(self.rho_vetoes.get() + 1);
+        let count = |c: &std::cell::Cell<usize>| c.set(c.get() + 1);
+        match self.w.keeps_rho(old, new) {
+            topo::RhoCheck::Keeps => true,
+            topo::RhoCheck::GivesWay => {
+                count(&self.rho_yields);
+                true
+            }
+            topo::RhoCheck::Vetoed => {
+                count(&self.rho_vetoes);
+                false
+            }
         }
-        keeps
     }
 
     fn bad(&self, t: u32, target: f64, improve: bool) -> bool {

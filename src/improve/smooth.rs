@@ -200,11 +200,10 @@ impl Improver<'_> {
         if qx <= q0 + SMOOTH_GAIN || qx.is_nan() || !self.valid_move(&star, v, x) {
             return false;
         }
-        let keeps = star.iter().zip(&ids).all(|(tv, &t)| {
-            let moved = tv.map(|u| if u == v { x } else { self.w.p(u) });
-            self.keeps_rho(&[t], [moved])
-        });
-        if !keeps {
+        let moved = star
+            .iter()
+            .map(|tv| tv.map(|u| if u == v { x } else { self.w.p(u) }));
+        if !self.keeps_rho(&ids, moved) {
             return false;
         }
         self.w.pos[v as usize] = x;

@@ -118,6 +118,7 @@ fn improver_for(mesh: &TetMesh) -> Improver<'static> {
         slide: None,
         stats: Stats::default(),
         rho_vetoes: Default::default(),
+        rho_yields: Default::default(),
     }
 }
 
@@ -406,6 +407,7 @@ fn insertion_lifts_a_flat_tet_off_a_fold() {
         slide: None,
         stats: Stats::default(),
         rho_vetoes: Default::default(),
+        rho_yields: Default::default(),
     };
     let plan = im.plan_insertion(0).expect("an insertion");
     let made = im.apply_insertion(plan);
@@ -455,6 +457,7 @@ fn deletion_removes_a_vertex_squeezed_against_a_face() {
         slide: None,
         stats: Stats::default(),
         rho_vetoes: Default::default(),
+        rho_yields: Default::default(),
     };
     let worst = (0..4u32)
         .min_by(|&a, &b| im.w.q[a as usize].total_cmp(&im.w.q[b as usize]))

@@ -43,9 +43,21 @@ pub(crate) struct Work {
     pub deleted: Vec<u32>,
     /// The radius-edge bound no change may break (`Options::keep_rho`; infinite: none).
     pub rho_limit: f64,
-    /// Vertices of the tets that exceeded `rho_limit` on entry: where refinement did not meet
-    /// the bound (next to small input angles), changes touching them are not held to it.
+    /// Vertices of the tets that exceeded `rho_limit` on entry and of the tets around them:
+    /// where refinement did not meet the bound (next to small input angles), changes touching
+    /// them are not held to it.
     pub rho_exempt: Vec<bool>,
+}
+
+/// What the radius-edge bound says of a change (`Work::keeps_rho`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RhoCheck {
+    /// No tet exceeds the bound where none did.
+    Keeps,
+    /// One would, next to where refinement left the bound unmet: the bound gives way.
+    GivesWay,
+    /// One would: the change is refused.
+    Vetoed,
 }
 
 /// Face `i` of tet `tv` (the one opposite its vertex `i`).
@@ -142,29 +154,31 @@ impl Work {
         if limit.is_infinite() {
             return;
         }
+        let mut over = vec![false; self.pos.len()];
         for t in 0..self.tets.len() {
             let tv = self.tets[t];
             if self.alive[t] && Self::rho_at(self.points(&tv)) > limit {
+                tv.iter().for_each(|&v| over[v as usize] = true);
+            }
+        }
+        // And the tets around those vertices: the changes that fix a bad tet there reach one
+        // ring out.
+        for t in 0..self.tets.len() {
+            let tv = self.tets[t];
+            if self.alive[t] && tv.iter().any(|&v| over[v as usize]) {
                 tv.iter().for_each(|&v| self.rho_exempt[v as usize] = true);
             }
         }
     }
 
-    /// Whether tets with corners `new` may replace the tets `old` under the radius-edge
-    /// bound: none of them above `rho_limit` unless an old tet was above it already, and then
-    /// none above the largest old one. Always true without a bound, and for changes touching
-    /// a vertex where the mesh exceeded the bound on entry (`rho_exempt`).
-    pub fn keeps_rho(&self, old: &[u32], new: impl IntoIterator<Item = [DVec3; 4]>) -> bool {
+    /// Whether tets with corners `new` may replace the tets `old` under the radius-edge bound:
+    /// none of them above `rho_limit` unless an old tet was above it already, and then none
+    /// above the largest old one. The bound gives way (`RhoCheck::GivesWay`) for changes
+    /// touching a vertex where the mesh exceeded it on entry or next to one (`rho_exempt`); it
+    /// always holds without a bound.
+    pub fn keeps_rho(&self, old: &[u32], new: impl IntoIterator<Item = [DVec3; 4]>) -> RhoCheck {
         if self.rho_limit.is_infinite() {
-            return true;
-        }
-        let exempt = |t: &u32| {
-            self.tets[*t as usize]
-                .iter()
-                .any(|&v| self.rho_exempt.get(v as usize).copied().unwrap_or(false))
-        };
-        if old.iter().any(exempt) {
-            return true;
+            return RhoCheck::Keeps;
         }
         let mut cap = self.rho_limit;
         // Most changes create no tet over the bound: the old tets are measured only then.
@@ -174,12 +188,23 @@ impl Work {
             .filter(|&r| r > cap)
             .collect();
         if over.is_empty() {
-            return true;
+            return RhoCheck::Keeps;
         }
         for &t in old {
             cap = cap.max(Self::rho_at(self.points(&self.tets[t as usize])));
         }
-        over.iter().all(|&r| r <= cap)
+        let exempt = |t: &u32| {
+            self.tets[*t as usize]
+                .iter()
+                .any(|&v| self.rho_exempt.get(v as usize).copied().unwrap_or(false))
+        };
+        if over.iter().all(|&r| r <= cap) {
+            RhoCheck::Keeps
+        } else if old.iter().any(exempt) {
+            RhoCheck::GivesWay
+        } else {
+            RhoCheck::Vetoed
+        }
     }
 
     pub fn worst_q(&self, tets: &[u32]) -> f64 {

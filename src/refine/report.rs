@@ -247,7 +247,7 @@ impl Report {
         row(
             "time improvement (s)",
             format!(
-                "{:.3} (flips {}, moves {}, insertions {}, deletions {}, rho0 vetoes {}{})",
+                "{:.3} (flips {}, moves {}, insertions {}, deletions {}, rho0 vetoes {} / gave way {}{})",
                 self.seconds_improvement,
                 self.improvement.edge_removals
                     + self.improvement.face_removals
@@ -257,6 +257,7 @@ impl Report {
                 self.improvement.insertions,
                 self.improvement.deletions,
                 self.improvement.rho_vetoes,
+                self.improvement.rho_yields,
                 if self.delaunay { ", Delaunay" } else { "" }
             ),
         );
