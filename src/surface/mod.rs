@@ -19,6 +19,7 @@ pub mod oracle;
 #[cfg(test)]
 mod tests;
 pub mod thickness;
+pub mod winding;
 
 use crate::plc::Plc;
 use glam::DVec3;
