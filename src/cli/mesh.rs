@@ -30,7 +30,7 @@ pub struct MeshOptions {
     /// Sliver bound sigma0 = V / L^3 (default 0.02).
     #[arg(long, value_name = "S")]
     pub sigma: Option<f64>,
-    /// Smallest dihedral angle allowed, in degrees (default 15).
+    /// Smallest dihedral angle allowed, in degrees (default 18).
     #[arg(long, value_name = "DEG")]
     pub min_dihedral: Option<f64>,
     /// Random seed (same input, parameters and seed: identical output).
@@ -413,6 +413,34 @@ mod tests {
 
     fn parse(args: &[&str]) -> Result<MeshOptions, clap::Error> {
         Opts::try_parse_from(std::iter::once("mesh").chain(args.iter().copied())).map(|o| o.mesh)
+    }
+
+    /// The defaults the options' help states are the library's (`Params::default()`).
+    #[test]
+    fn help_states_the_library_defaults() {
+        use clap::CommandFactory;
+        let cmd = Opts::command();
+        let d = Params::default();
+        let stated = |long: &str| -> f64 {
+            let arg = cmd
+                .get_arguments()
+                .find(|a| a.get_long() == Some(long))
+                .unwrap_or_else(|| panic!("--{long}"));
+            let help = arg.get_help().map(|h| h.to_string()).unwrap_or_default();
+            let after = help
+                .split("default ")
+                .nth(1)
+                .unwrap_or_else(|| panic!("--{long}: no default in {help:?}"));
+            let number: String = after
+                .chars()
+                .take_while(|c| c.is_ascii_digit() || *c == '.')
+                .collect();
+            number.trim_end_matches('.').parse().unwrap()
+        };
+        assert_eq!(stated("rho"), d.rho0);
+        assert_eq!(stated("sigma"), d.sigma0);
+        assert_eq!(stated("min-dihedral"), d.min_dihedral);
+        assert_eq!(stated("feature-angle"), d.feature_angle);
     }
 
     #[test]

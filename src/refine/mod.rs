@@ -156,10 +156,11 @@ impl Params {
                 self.small_angle_reach
             ));
         }
-        if !(self.sigma0.is_finite() && self.sigma0 >= 0.0) {
+        if !(self.sigma0.is_finite() && (0.0..crate::geom::REGULAR_SIGMA).contains(&self.sigma0)) {
             return Err(format!(
-                "parameter sigma0 = {} must be finite and >= 0",
-                self.sigma0
+                "parameter sigma0 = {} must be in [0, {:.4}) (the regular tet's V/L^3)",
+                self.sigma0,
+                crate::geom::REGULAR_SIGMA
             ));
         }
         if !(self.min_dihedral.is_finite() && (0.0..70.5).contains(&self.min_dihedral)) {
