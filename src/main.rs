@@ -42,7 +42,7 @@ enum Command {
     Delaunay {
         /// Input point file.
         points: PathBuf,
-        /// Write the mesh here (.vtu, .mesh, .msh or .node/.ele, chosen by extension).
+        /// Write the mesh here (.vtu, .mesh, .msh, .node/.ele or Abaqus .inp, chosen by extension).
         #[arg(short, long, value_name = "OUT")]
         output: Option<PathBuf>,
         /// Write the run's statistics as JSON to this file.
@@ -51,7 +51,7 @@ enum Command {
     },
     /// Mesh a domain (.poly, .smesh, .off, .stl, .ply, .obj) with quality refinement, or remove the
     /// slivers of an existing mesh (.mesh). Output format by extension (.vtu, .mesh, .msh,
-    /// .node/.ele). Surfaces (.off, .stl, .ply, .obj) are approximated by default, .poly/.smesh
+    /// .node/.ele, .inp). Surfaces (.off, .stl, .ply, .obj) are approximated by default, .poly/.smesh
     /// facets kept (--surface).
     Mesh {
         /// Input domain or existing mesh.

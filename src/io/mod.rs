@@ -26,6 +26,7 @@ use crate::plc::PlcInput;
 use std::path::Path;
 
 pub use crate::plc::coplanar;
+pub mod abaqus;
 pub mod gmsh;
 pub mod medit;
 pub mod obj;
@@ -90,6 +91,9 @@ pub fn is_surface_file(path: &Path) -> bool {
 /// Extensions accepted by [`write_mesh`] and [`read_mesh`].
 pub const MESH_EXTENSIONS: &[&str] = &["vtu", "mesh", "msh", "node", "ele", "face"];
 
+/// Extensions accepted by [`write_mesh`]: [`MESH_EXTENSIONS`] and Abaqus `.inp` (written only).
+pub const WRITE_EXTENSIONS: &[&str] = &["vtu", "mesh", "msh", "node", "ele", "face", "inp"];
+
 /// The lower-cased extension of `path`, or an error listing the supported ones.
 fn extension(path: &Path, supported: &[&str], what: &str) -> Result<String, IoError> {
     let ext = path
@@ -129,13 +133,13 @@ pub fn read_plc(path: &Path, options: &ReadOptions) -> Result<PlcInput, IoError>
     }
 }
 
-/// Writes a mesh (.vtu, .mesh, .msh, .node/.ele/.face), format chosen by extension.
+/// Writes a mesh (.vtu, .mesh, .msh, .node/.ele/.face, .inp), format chosen by extension.
 ///
 /// `cell_fields` are written as cell data by `.vtu` only; the other formats have no place for
 /// them and ignore them (their lengths are still checked). A TetGen extension writes all three
 /// of `X.node`, `X.ele` and `X.face`.
 pub fn write_mesh(path: &Path, mesh: &TetMesh, cell_fields: &[CellField]) -> Result<(), IoError> {
-    let ext = extension(path, MESH_EXTENSIONS, "mesh")?;
+    let ext = extension(path, WRITE_EXTENSIONS, "mesh")?;
     let lens: Vec<(&str, usize)> = cell_fields
         .iter()
         .map(|f| (f.name, f.values.len()))
@@ -145,6 +149,7 @@ pub fn write_mesh(path: &Path, mesh: &TetMesh, cell_fields: &[CellField]) -> Res
         "vtu" => vtu::write_vtu(path, mesh, cell_fields),
         "mesh" => medit::write_medit(path, mesh),
         "msh" => gmsh::write_msh(path, mesh),
+        "inp" => abaqus::write_inp(path, mesh),
         _ => tetgen::write_tetgen(path, mesh),
     }
 }
