@@ -484,7 +484,8 @@ sm_status sm_get_boundary_faces(const sm_mesher *m,
 /**
  * Writes the mesh to `path`, format by extension: .vtu (ParaView, with per-tet rho, sigma,
  * aspect and dihedral angles as cell data), .mesh (medit), .msh (gmsh 4.1), .node (TetGen
- * .node/.ele/.face). `SM_ERR_IO` names the file on failure.
+ * .node/.ele/.face), .inp (Abaqus: C3D4, an element set per region, a surface per boundary
+ * marker). `SM_ERR_IO` names the file on failure.
  *
  * # Safety
  * `m` is NULL or a live handle; `path` is NULL or a NUL-terminated string.

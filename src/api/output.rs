@@ -32,31 +32,34 @@ pub struct QualityFields {
 impl QualityFields {
     /// Computes every measure of every tet of `mesh`.
     pub fn of(mesh: &TetMesh) -> Self {
-        let n = mesh.tets.len();
-        let mut q = QualityFields {
-            rho: Vec::with_capacity(n),
-            sigma: Vec::with_capacity(n),
-            aspect: Vec::with_capacity(n),
-            min_dihedral: Vec::with_capacity(n),
-            max_dihedral: Vec::with_capacity(n),
-        };
-        for t in &mesh.tets {
-            let [a, b, c, d] = t.map(|i| mesh.vertices[i as usize]);
-            let m = TetQuality::of(a, b, c, d);
-            q.rho.push(m.rho);
-            q.sigma.push(m.sigma);
-            q.aspect.push(m.aspect);
-            q.min_dihedral.push(m.min_dihedral);
-            q.max_dihedral.push(m.max_dihedral);
-        }
-        q
+        let measures: Vec<TetQuality> = mesh
+            .tets
+            .iter()
+            .map(|t| {
+                let [a, b, c, d] = t.map(|i| mesh.vertices[i as usize]);
+                TetQuality::of(a, b, c, d)
+            })
+            .collect();
+        Self::from_measures(&measures)
     }
 
-    /// The fields as writer cell data (names as they appear in ParaView).
+    /// The fields of tets measured already (`quality::per_tet`).
+    pub fn from_measures(measures: &[TetQuality]) -> Self {
+        QualityFields {
+            rho: measures.iter().map(|m| m.rho).collect(),
+            sigma: measures.iter().map(|m| m.sigma).collect(),
+            aspect: measures.iter().map(|m| m.aspect).collect(),
+            min_dihedral: measures.iter().map(|m| m.min_dihedral).collect(),
+            max_dihedral: measures.iter().map(|m| m.max_dihedral).collect(),
+        }
+    }
+
+    /// The fields as writer cell data, named as they appear in ParaView: the one set of names
+    /// every `.vtu` we write uses (the API's, the CLI's, the C ABI's `sm_write`).
     pub fn cell_fields(&self) -> [CellField<'_>; 5] {
         [
             CellField {
-                name: "rho",
+                name: "radius_edge_ratio",
                 values: &self.rho,
             },
             CellField {
@@ -68,11 +71,11 @@ impl QualityFields {
                 values: &self.aspect,
             },
             CellField {
-                name: "min_dihedral",
+                name: "min_dihedral_deg",
                 values: &self.min_dihedral,
             },
             CellField {
-                name: "max_dihedral",
+                name: "max_dihedral_deg",
                 values: &self.max_dihedral,
             },
         ]

@@ -3,7 +3,7 @@
 use indicatif::{ProgressBar, ProgressStyle};
 use slivermesh::geom::TetQuality;
 use slivermesh::improve;
-use slivermesh::io::{self, CellField, ReadOptions};
+use slivermesh::io::{self, ReadOptions};
 use slivermesh::mesh::TetMesh;
 use slivermesh::pipeline;
 use slivermesh::plc::{Facet, PlcInput, Region};
@@ -293,7 +293,7 @@ fn surface_table(s: &SurfaceReport) -> String {
     out
 }
 
-/// Writes the mesh, with per-tet quality as cell data (radius-edge ratio, sigma, min dihedral)
+/// Writes the mesh, with per-tet quality as cell data (`api::QualityFields`)
 /// when the format is .vtu: from `per_tet` (`quality::per_tet`) when given.
 pub fn write_with_quality(
     path: &Path,
@@ -315,23 +315,8 @@ pub fn write_with_quality(
             &measured
         }
     };
-    let rho: Vec<f64> = per_tet.iter().map(|q| q.rho).collect();
-    let sigma: Vec<f64> = per_tet.iter().map(|q| q.sigma).collect();
-    let dihedral: Vec<f64> = per_tet.iter().map(|q| q.min_dihedral).collect();
-    let fields = [
-        CellField {
-            name: "radius_edge_ratio",
-            values: &rho,
-        },
-        CellField {
-            name: "sigma",
-            values: &sigma,
-        },
-        CellField {
-            name: "min_dihedral_deg",
-            values: &dihedral,
-        },
-    ];
+    let fields = slivermesh::api::QualityFields::from_measures(per_tet);
+    let fields = fields.cell_fields();
     io::write_mesh(path, mesh, &fields).map_err(|e| e.to_string())
 }
 
