@@ -69,6 +69,10 @@ pub struct MeshOptions {
     /// length; default 0.001 x the input's bounding-box diagonal).
     #[arg(long, value_name = "D", allow_negative_numbers = true)]
     pub surface_distance: Option<f64>,
+    /// Write the binary form of the output format where it has one (.msh: gmsh 4.1 binary);
+    /// the other formats are written as usual.
+    #[arg(long)]
+    pub binary: bool,
 }
 
 /// `--surface`: how the input facets bound the domain (`refine::SurfaceMode`).
@@ -189,7 +193,7 @@ pub fn run_mesh(
         .map_err(|e| e.to_string())?;
         mesh_with_progress(&plc, &params, spacing)?
     };
-    finish(&mesh, &report, output, stats_json, quality_svg)
+    finish(&mesh, &report, output, stats_json, quality_svg, opts.binary)
 }
 
 /// `pipeline::mesh` (the surface mode, refinement, improvement) with a spinner on a terminal.
@@ -228,6 +232,7 @@ fn finish(
     output: Option<&Path>,
     stats_json: Option<&Path>,
     quality_svg: Option<&Path>,
+    binary: bool,
 ) -> Result<(), String> {
     println!("{}", report.table());
     if let Some(surface) = &report.surface {
@@ -240,7 +245,7 @@ fn finish(
     // Every tet measured once, for the .vtu's cell data and the quality table.
     let per_tet = slivermesh::quality::per_tet(mesh).ok();
     if let Some(path) = output {
-        write_with_quality(path, mesh, per_tet.as_deref())?;
+        write_with_quality(path, mesh, per_tet.as_deref(), binary)?;
         println!("wrote {}", path.display());
     }
     // Measured on the mesh as written, the table `slivermesh quality` prints for that file.
@@ -294,12 +299,20 @@ fn surface_table(s: &SurfaceReport) -> String {
 }
 
 /// Writes the mesh, with per-tet quality as cell data (`api::QualityFields`)
-/// when the format is .vtu: from `per_tet` (`quality::per_tet`) when given.
+/// when the format is .vtu: from `per_tet` (`quality::per_tet`) when given. `binary`: a .msh is
+/// written in gmsh's binary form.
 pub fn write_with_quality(
     path: &Path,
     mesh: &TetMesh,
     per_tet: Option<&[TetQuality]>,
+    binary: bool,
 ) -> Result<(), String> {
+    let msh = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("msh"));
+    if binary && msh {
+        return io::gmsh_binary::write_msh_binary(path, mesh).map_err(|e| e.to_string());
+    }
     // Only .vtu has a place for cell data: measuring every tet for another format is wasted.
     if !path
         .extension()
@@ -382,6 +395,7 @@ pub fn run_demo() -> Result<(), String> {
         Some(Path::new("slivermesh-demo.vtu")),
         None,
         None,
+        false,
     )
 }
 

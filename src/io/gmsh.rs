@@ -1,4 +1,5 @@
-//! Gmsh `.msh` version 4.1 ASCII writer, and a reader for the same subset.
+//! Gmsh `.msh` version 4.1 ASCII writer, and a reader for the same subset (the binary form of
+//! the same content: `super::gmsh_binary`).
 //!
 //! Written (valid per the MSH 4.1 specification; checked with gmsh 4.15 and meshio 5.3):
 //! - `$MeshFormat` `4.1 0 8`.
@@ -46,9 +47,9 @@ pub fn write_msh(path: &Path, mesh: &TetMesh) -> Result<(), IoError> {
 }
 
 /// An entity of the written file: its value (region or marker) and element ids.
-struct Entity {
-    value: i32,
-    elements: Vec<usize>,
+pub(super) struct Entity {
+    pub value: i32,
+    pub elements: Vec<usize>,
 }
 
 /// Groups element ids by value, in order of first appearance.
@@ -69,7 +70,7 @@ fn group(values: &[i32]) -> Vec<Entity> {
 }
 
 /// Bounding box of the vertices of some elements (of all vertices when there are none).
-fn bbox<const N: usize>(mesh: &TetMesh, elems: &[[u32; N]], ids: &[usize]) -> [f64; 6] {
+pub(super) fn bbox<const N: usize>(mesh: &TetMesh, elems: &[[u32; N]], ids: &[usize]) -> [f64; 6] {
     let mut lo = DVec3::splat(f64::INFINITY);
     let mut hi = DVec3::splat(f64::NEG_INFINITY);
     let mut add = |p: DVec3| {
@@ -98,11 +99,9 @@ fn write_entity<W: Write>(w: &mut W, tag: usize, b: [f64; 6], value: i32) -> std
     writeln!(w, " 1 {value} 0")
 }
 
-/// Writes `mesh` in gmsh 4.1 ASCII format to any writer.
-/// An inconsistent mesh is an `InvalidInput` error.
-pub fn format_msh<W: Write>(w: &mut W, mesh: &TetMesh) -> std::io::Result<()> {
-    check_mesh_io(mesh, &[])?;
-    let (nv, nt, nb) = (mesh.vertices.len(), mesh.tets.len(), mesh.boundary.len());
+/// The volume entities (one per region attribute, at least one) and surface entities (one per
+/// boundary marker) of `mesh`, in order of first appearance.
+pub(super) fn entities(mesh: &TetMesh) -> (Vec<Entity>, Vec<Entity>) {
     let mut volumes = group(&mesh.tet_regions);
     if volumes.is_empty() {
         volumes.push(Entity {
@@ -110,9 +109,15 @@ pub fn format_msh<W: Write>(w: &mut W, mesh: &TetMesh) -> std::io::Result<()> {
             elements: Vec::new(),
         });
     }
-    let surfaces = group(&mesh.boundary_markers);
-    writeln!(w, "$MeshFormat\n4.1 0 8\n$EndMeshFormat")?;
+    (volumes, group(&mesh.boundary_markers))
+}
 
+/// `$PhysicalNames` (ASCII in both forms): `region_v` per volume, `marker_m` per surface.
+pub(super) fn write_physical_names<W: Write>(
+    w: &mut W,
+    volumes: &[Entity],
+    surfaces: &[Entity],
+) -> std::io::Result<()> {
     let names: Vec<(u8, i32)> = volumes
         .iter()
         .map(|e| (3, e.value))
@@ -126,6 +131,17 @@ pub fn format_msh<W: Write>(w: &mut W, mesh: &TetMesh) -> std::io::Result<()> {
         }
         writeln!(w, "$EndPhysicalNames")?;
     }
+    Ok(())
+}
+
+/// Writes `mesh` in gmsh 4.1 ASCII format to any writer.
+/// An inconsistent mesh is an `InvalidInput` error.
+pub fn format_msh<W: Write>(w: &mut W, mesh: &TetMesh) -> std::io::Result<()> {
+    check_mesh_io(mesh, &[])?;
+    let (nv, nt, nb) = (mesh.vertices.len(), mesh.tets.len(), mesh.boundary.len());
+    let (volumes, surfaces) = entities(mesh);
+    writeln!(w, "$MeshFormat\n4.1 0 8\n$EndMeshFormat")?;
+    write_physical_names(w, &volumes, &surfaces)?;
 
     writeln!(w, "$Entities\n0 0 {} {}", surfaces.len(), volumes.len())?;
     for (k, e) in surfaces.iter().enumerate() {

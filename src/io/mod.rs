@@ -28,6 +28,7 @@ use std::path::Path;
 pub use crate::plc::coplanar;
 pub mod abaqus;
 pub mod gmsh;
+pub mod gmsh_binary;
 pub mod medit;
 pub mod obj;
 pub mod off;
