@@ -69,8 +69,8 @@ pub struct MeshOptions {
     /// length; default 0.001 x the input's bounding-box diagonal).
     #[arg(long, value_name = "D", allow_negative_numbers = true)]
     pub surface_distance: Option<f64>,
-    /// Write the binary form of the output format where it has one (.msh: gmsh 4.1 binary);
-    /// the other formats are written as usual.
+    /// Write the binary form of the output format where it has one (.msh: gmsh 4.1 binary;
+    /// .vtu: binary appended arrays); the other formats are written as usual.
     #[arg(long)]
     pub binary: bool,
 }
@@ -299,8 +299,8 @@ fn surface_table(s: &SurfaceReport) -> String {
 }
 
 /// Writes the mesh, with per-tet quality as cell data (`api::QualityFields`)
-/// when the format is .vtu: from `per_tet` (`quality::per_tet`) when given. `binary`: a .msh is
-/// written in gmsh's binary form.
+/// when the format is .vtu: from `per_tet` (`quality::per_tet`) when given. `binary`: a .msh or
+/// .vtu is written in its binary form.
 pub fn write_with_quality(
     path: &Path,
     mesh: &TetMesh,
@@ -330,6 +330,9 @@ pub fn write_with_quality(
     };
     let fields = slivermesh::api::QualityFields::from_measures(per_tet);
     let fields = fields.cell_fields();
+    if binary {
+        return io::vtu_binary::write_vtu_binary(path, mesh, &fields).map_err(|e| e.to_string());
+    }
     io::write_mesh(path, mesh, &fields).map_err(|e| e.to_string())
 }
 

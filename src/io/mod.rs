@@ -40,6 +40,7 @@ pub mod stl;
 pub mod tetgen;
 mod text;
 pub mod vtu;
+pub mod vtu_binary;
 
 #[cfg(test)]
 pub(crate) mod tests;

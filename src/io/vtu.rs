@@ -1,4 +1,5 @@
-//! VTK XML UnstructuredGrid (`.vtu`) writer, and a reader for the same subset.
+//! VTK XML UnstructuredGrid (`.vtu`) writer, and a reader for the same subset (the binary
+//! appended form of the same arrays: `super::vtu_binary`, written only).
 //!
 //! Written (VTK file version 1.0, ASCII, one `Piece`): `Points` as `Float64` with 3
 //! components; `Cells` with `connectivity` and `offsets` as `Int64` and `types` as `UInt8`
@@ -40,7 +41,7 @@ pub fn write_vtu(path: &Path, mesh: &TetMesh, cell_fields: &[CellField]) -> Resu
 }
 
 /// Escapes a string for an XML attribute value.
-fn xml_escape(s: &str) -> String {
+pub(super) fn xml_escape(s: &str) -> String {
     let mut out = String::with_capacity(s.len());
     for c in s.chars() {
         match c {

@@ -1,0 +1,174 @@
+//! VTK XML UnstructuredGrid (`.vtu`) writer in the binary appended form: the same arrays as
+//! [`super::vtu::format_vtu`] (points, connectivity, offsets, types, `region`, the cell fields),
+//! each `format="appended"` with its `offset` into one `<AppendedData encoding="raw">` block,
+//! where it is stored as a `UInt64` byte count followed by its little-endian values
+//! (`header_type="UInt64"`). About a third of the ASCII file's size, and no number formatting.
+//! This module's reader does not read it back (`super::vtu` reads ASCII arrays only); VTK does
+//! (the ctest `vtk_readback_binary_*`).
+
+use super::text::{check_mesh, check_mesh_io, create, with_path, write_err};
+use super::{CellField, IoError};
+use crate::mesh::TetMesh;
+use std::io::Write;
+use std::path::Path;
+
+/// Writes `mesh` with `cell_fields` as a binary appended `.vtu` file.
+pub fn write_vtu_binary(
+    path: &Path,
+    mesh: &TetMesh,
+    cell_fields: &[CellField],
+) -> Result<(), IoError> {
+    let lens: Vec<(&str, usize)> = cell_fields
+        .iter()
+        .map(|f| (f.name, f.values.len()))
+        .collect();
+    check_mesh(mesh, &lens).map_err(|e| with_path(e, path))?;
+    let mut w = create(path)?;
+    format_vtu_binary(&mut w, mesh, cell_fields)
+        .and_then(|_| w.flush())
+        .map_err(|e| write_err(path, e))
+}
+
+/// One appended array: its XML attributes and its byte length.
+struct Array {
+    attributes: String,
+    bytes: usize,
+}
+
+/// Writes `mesh` in the binary appended `.vtu` form to any writer.
+pub fn format_vtu_binary<W: Write>(
+    w: &mut W,
+    mesh: &TetMesh,
+    cell_fields: &[CellField],
+) -> std::io::Result<()> {
+    let lens: Vec<(&str, usize)> = cell_fields
+        .iter()
+        .map(|f| (f.name, f.values.len()))
+        .collect();
+    check_mesh_io(mesh, &lens)?;
+    let (nv, nt) = (mesh.vertices.len(), mesh.tets.len());
+    let array = |attributes: String, bytes: usize| Array { attributes, bytes };
+    let points = array(
+        "type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\"".into(),
+        24 * nv,
+    );
+    let cells = [
+        array("type=\"Int64\" Name=\"connectivity\"".into(), 32 * nt),
+        array("type=\"Int64\" Name=\"offsets\"".into(), 8 * nt),
+        array("type=\"UInt8\" Name=\"types\"".into(), nt),
+    ];
+    let mut cell_data = vec![array("type=\"Int32\" Name=\"region\"".into(), 4 * nt)];
+    for f in cell_fields {
+        cell_data.push(array(
+            format!(
+                "type=\"Float64\" Name=\"{}\"",
+                super::vtu::xml_escape(f.name)
+            ),
+            8 * f.values.len(),
+        ));
+    }
+    let mut offset = 0usize;
+    let mut tag = |w: &mut W, a: &Array| -> std::io::Result<()> {
+        writeln!(
+            w,
+            "<DataArray {} format=\"appended\" offset=\"{offset}\"/>",
+            a.attributes
+        )?;
+        offset += 8 + a.bytes;
+        Ok(())
+    };
+    writeln!(w, "<?xml version=\"1.0\"?>")?;
+    writeln!(
+        w,
+        "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" \
+         header_type=\"UInt64\">"
+    )?;
+    writeln!(w, "<UnstructuredGrid>")?;
+    writeln!(w, "<Piece NumberOfPoints=\"{nv}\" NumberOfCells=\"{nt}\">")?;
+    writeln!(w, "<Points>")?;
+    tag(w, &points)?;
+    writeln!(w, "</Points>\n<Cells>")?;
+    for a in &cells {
+        tag(w, a)?;
+    }
+    writeln!(w, "</Cells>\n<CellData Scalars=\"region\">")?;
+    for a in &cell_data {
+        tag(w, a)?;
+    }
+    writeln!(w, "</CellData>\n</Piece>\n</UnstructuredGrid>")?;
+    w.write_all(b"<AppendedData encoding=\"raw\">\n_")?;
+    let header = |w: &mut W, bytes: usize| w.write_all(&(bytes as u64).to_le_bytes());
+    header(w, points.bytes)?;
+    for p in &mesh.vertices {
+        for x in p.to_array() {
+            w.write_all(&x.to_le_bytes())?;
+        }
+    }
+    header(w, cells[0].bytes)?;
+    for t in &mesh.tets {
+        for v in t {
+            w.write_all(&i64::from(*v).to_le_bytes())?;
+        }
+    }
+    header(w, cells[1].bytes)?;
+    for i in 1..=nt {
+        w.write_all(&(4 * i as i64).to_le_bytes())?;
+    }
+    header(w, cells[2].bytes)?;
+    w.write_all(&vec![10u8; nt])?;
+    header(w, cell_data[0].bytes)?;
+    for r in &mesh.tet_regions {
+        w.write_all(&r.to_le_bytes())?;
+    }
+    for (f, a) in cell_fields.iter().zip(&cell_data[1..]) {
+        header(w, a.bytes)?;
+        for x in f.values {
+            w.write_all(&x.to_le_bytes())?;
+        }
+    }
+    w.write_all(b"\n</AppendedData>\n</VTKFile>\n")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    /// The XML offsets point at each array's byte-count header in the appended block.
+    #[test]
+    fn offsets_point_at_the_arrays() {
+        let m = TetMesh {
+            vertices: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z],
+            tets: vec![[0, 1, 2, 3]],
+            tet_regions: vec![7],
+            boundary: vec![],
+            boundary_markers: vec![],
+        };
+        let values = [0.5];
+        let fields = [CellField {
+            name: "sigma",
+            values: &values,
+        }];
+        let mut out = Vec::new();
+        format_vtu_binary(&mut out, &m, &fields).unwrap();
+        let start = out.windows(2).position(|w| w == b"\n_").unwrap() + 2;
+        let text = String::from_utf8_lossy(&out[..start]).to_string();
+        let offsets: Vec<usize> = text
+            .split("offset=\"")
+            .skip(1)
+            .map(|s| s[..s.find('"').unwrap()].parse().unwrap())
+            .collect();
+        assert_eq!(offsets.len(), 6, "points, 3 cell arrays, region, sigma");
+        let u64_at = |o: usize| u64::from_le_bytes(out[o..o + 8].try_into().unwrap()) as usize;
+        let sizes = [96, 32, 8, 1, 4, 8];
+        for (o, size) in offsets.iter().zip(sizes) {
+            assert_eq!(u64_at(start + o), size);
+        }
+        // region 7, then sigma 0.5.
+        let region = start + offsets[4] + 8;
+        assert_eq!(&out[region..region + 4], &7i32.to_le_bytes());
+        let sigma = start + offsets[5] + 8;
+        assert_eq!(&out[sigma..sigma + 8], &0.5f64.to_le_bytes());
+        assert!(out.ends_with(b"\n</AppendedData>\n</VTKFile>\n"));
+    }
+}
