@@ -468,6 +468,37 @@ fn several_regions_in_keep_mode() {
     }
 }
 
+/// Several regions, both surface modes: the same input, parameters and seed give the same mesh.
+#[test]
+fn several_regions_are_deterministic() {
+    if cfg!(debug_assertions) {
+        eprintln!("skipped in a debug build: run cargo test --release");
+        return;
+    }
+    let shape = corpus::three_regions_edge();
+    let dir = ScratchDir::new("determinism");
+    let path = dir.0.join(shape.file_name());
+    std::fs::write(&path, shape.file_text()).unwrap();
+    let input = slivermesh::io::read_plc(&path, &Default::default()).unwrap();
+    for mode in [
+        slivermesh::refine::SurfaceMode::Keep,
+        slivermesh::refine::SurfaceMode::Approximate,
+    ] {
+        let params = slivermesh::refine::Params {
+            surface_mode: mode,
+            ..Default::default()
+        };
+        let run = || {
+            slivermesh::pipeline::mesh(&input, &params, None, None)
+                .unwrap()
+                .0
+        };
+        let (a, b) = (run(), run());
+        assert_eq!(a, b, "{mode:?}: two runs differ");
+        assert!(a.tet_regions.contains(&3), "{mode:?}: three regions");
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // The corpus itself.
 
