@@ -37,6 +37,36 @@ pub(crate) fn check_facet_intersections(
     first_error_by_sweep(vertices, topo, &boxes)
 }
 
+/// Every pair of `triangles` (ids into `vertices`) that meet in more than their shared
+/// vertices and edges, lower id first, sorted; the `flat` ones (collinear corners) take no
+/// part.
+pub(crate) fn clashing_pairs(
+    vertices: &[DVec3],
+    triangles: &[[u32; 3]],
+    flat: &[bool],
+) -> Vec<[u32; 2]> {
+    let pts = |t: [u32; 3]| t.map(|v| vertices[v as usize]);
+    let boxes: Vec<Box3> = triangles
+        .iter()
+        .map(|&t| {
+            let [a, b, c] = pts(t);
+            (a.min(b).min(c), a.max(b).max(c))
+        })
+        .collect();
+    let mut pairs = Vec::new();
+    BoxGrid::new(&boxes).for_each_overlap(&boxes, |i, j| {
+        if flat[i] || flat[j] {
+            return;
+        }
+        let (ti, tj) = (triangles[i], triangles[j]);
+        if matches!(triangle_contact(ti, pts(ti), tj, pts(tj)), Contact::Clash) {
+            pairs.push([i.min(j) as u32, i.max(j) as u32]);
+        }
+    });
+    pairs.sort_unstable();
+    pairs
+}
+
 /// The exact test of triangles i and j (boxes overlapping), nothing if they share a facet.
 fn check_pair(vertices: &[DVec3], topo: &Topology, i: usize, j: usize) -> Result<(), PlcError> {
     let pts = |t: [u32; 3]| t.map(|v| vertices[v as usize]);

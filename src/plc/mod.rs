@@ -15,7 +15,7 @@ pub mod coplanar;
 mod error;
 pub(crate) mod exact;
 mod facet;
-mod intersect;
+pub(crate) mod intersect;
 mod plane;
 mod topology;
 

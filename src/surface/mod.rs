@@ -16,6 +16,7 @@
 pub mod distance;
 pub mod features;
 pub mod oracle;
+pub mod repair;
 #[cfg(test)]
 mod tests;
 pub mod thickness;

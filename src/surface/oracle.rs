@@ -65,6 +65,10 @@ pub struct Crossing {
     pub point: DVec3,
     /// Through the triangle's interior, not an edge, a vertex or an end of the segment.
     pub proper: bool,
+    /// The change of the winding count from the segment's start to its end across this
+    /// triangle: +1 from its front (the side its normal points to) to its back, -1 the other
+    /// way, 0 when not proper.
+    pub delta: i8,
 }
 
 /// Where a point lies relative to a closed surface.
@@ -96,6 +100,8 @@ pub struct SurfaceOracle {
     frames: Vec<Option<Frame>>,
     /// Per triangle: the regions on its two sides (`InputSurface::sides`).
     sides: Vec<[u32; 2]>,
+    /// Regions are winding counts (`Self::counting`), not `sides`.
+    counting: bool,
     pad: f64,
     diagonal: f64,
 }
@@ -113,6 +119,18 @@ impl SurfaceOracle {
     /// query prunes well enough by whole triangles, and the tree is cheaper to build).
     pub fn for_distances(surface: &InputSurface) -> SurfaceOracle {
         Self::build(surface, false)
+    }
+
+    /// An oracle whose regions are winding counts: the number of times the oriented triangles
+    /// wind around a point (as `i32` bits in a `u32`), carried across each crossing by its
+    /// `delta`. For a surface that is closed as an oriented cycle (every edge used as often in
+    /// each direction, however many triangles meet there, intersecting or not) the count is
+    /// the winding number itself.
+    pub fn counting(surface: &InputSurface) -> SurfaceOracle {
+        SurfaceOracle {
+            counting: true,
+            ..Self::build(surface, true)
+        }
     }
 
     fn build(surface: &InputSurface, for_segments: bool) -> SurfaceOracle {
@@ -138,6 +156,7 @@ impl SurfaceOracle {
             },
             frames: corners.iter().map(|&c| Frame::of(c)).collect(),
             sides: surface.sides.clone(),
+            counting: false,
             corners,
             pieces,
             flat: (0..n).map(|t| is_flat(surface.corners(t))).collect(),
@@ -427,12 +446,14 @@ impl SurfaceOracle {
                 return;
             }
             let [a, b, c] = self.corners[t as usize];
-            if let Some((t_param, proper)) = segment_meets(p, q, a, b, c) {
+            if let Some((t_param, delta)) = segment_meets(p, q, a, b, c) {
+                let proper = delta != 0;
                 out.push(Crossing {
                     triangle: t,
                     t: t_param,
                     point: p + (q - p) * t_param,
                     proper,
+                    delta,
                 });
                 if proper {
                     odd = !odd;
@@ -446,15 +467,27 @@ impl SurfaceOracle {
     }
 
     /// The region at the end of a segment that starts in region `from` and meets `crossings`
-    /// (sorted along it, as [`Self::crossings`] gives them): each crossing passes from one
-    /// side of its triangle to the other. None when that is not clean to tell: a crossing is
-    /// not proper, or the region reached is on neither side of the next triangle (crossings
-    /// whose order rounding decided). With one region this is the parity of the crossings.
+    /// (sorted along it, as [`Self::crossings`] gives them; `forward` false: the segment is
+    /// walked from its end back to its start): each crossing passes from one side of its
+    /// triangle to the other. None when that is not clean to tell: a crossing is not proper,
+    /// or the region reached is on neither side of the next triangle (crossings whose order
+    /// rounding decided). With one region this is the parity of the crossings; a counting
+    /// oracle adds up their deltas.
     pub fn region_across<'c>(
         &self,
         from: u32,
         crossings: impl IntoIterator<Item = &'c Crossing>,
+        forward: bool,
     ) -> Option<u32> {
+        if self.counting {
+            let sign = if forward { 1 } else { -1 };
+            return crossings
+                .into_iter()
+                .try_fold(from as i32, |n, x| {
+                    x.proper.then_some(n + sign * i32::from(x.delta))
+                })
+                .map(|n| n as u32);
+        }
         crossings.into_iter().try_fold(from, |r, x| {
             let [a, b] = self.sides[x.triangle as usize];
             match () {
@@ -476,11 +509,15 @@ impl SurfaceOracle {
             let q = p + ray_direction(k) * far;
             match self.ray_region(p, q) {
                 Some(Ok(r)) => return r,
+                Some(Err(_)) if self.counting => return 1,
                 Some(Err(t)) => return self.sides[t as usize][0].max(self.sides[t as usize][1]),
                 None => continue,
             }
         }
         // Only a point on the surface's edges grazes every one of MAX_RAYS directions.
+        if self.counting {
+            return 1;
+        }
         self.closest(p).map_or(0, |c| {
             let [a, b] = self.sides[c.triangle as usize];
             a.max(b)
@@ -507,6 +544,8 @@ impl SurfaceOracle {
                         t: dp / (dp - dq),
                         point: p,
                         proper: true,
+                        // Walked from q: into the triangle's back when q is in front.
+                        delta: if dq > 0.0 { 1 } else { -1 },
                     });
                 }
                 Crossed::Degenerate => degenerate = true,
@@ -521,7 +560,7 @@ impl SurfaceOracle {
         }
         // From q (outside) back to p.
         hits.sort_by(|x, y| y.t.total_cmp(&x.t).then(x.triangle.cmp(&y.triangle)));
-        self.region_across(0, &hits).map(Ok)
+        self.region_across(0, &hits, true).map(Ok)
     }
 
     /// Inside, outside or on the closed surface, by the parity of proper crossings of a ray;
@@ -956,7 +995,7 @@ fn proper_crossing(p: DVec3, q: DVec3, a: DVec3, b: DVec3, c: DVec3) -> Crossed 
     }
 }
 
-fn is_flat([a, b, c]: [DVec3; 3]) -> bool {
+pub(crate) fn is_flat([a, b, c]: [DVec3; 3]) -> bool {
     let n = (b - a).cross(c - a);
     // Exactly collinear corners have a zero cross product in every rounding only when they
     // are degenerate; a tiny non-zero one is still a valid (thin) triangle for orient3d.
@@ -979,9 +1018,9 @@ fn is_flat([a, b, c]: [DVec3; 3]) -> bool {
 }
 
 /// Whether the closed segment [p, q] meets triangle (a, b, c) (exact) and if so where, as
-/// a parameter along it, and whether the crossing is proper: through the triangle's interior
-/// with both ends off its plane.
-fn segment_meets(p: DVec3, q: DVec3, a: DVec3, b: DVec3, c: DVec3) -> Option<(f64, bool)> {
+/// a parameter along it, and the crossing's `Crossing::delta` (0 unless proper: through the
+/// triangle's interior with both ends off its plane).
+fn segment_meets(p: DVec3, q: DVec3, a: DVec3, b: DVec3, c: DVec3) -> Option<(f64, i8)> {
     let dp = orient3d(a, b, c, p);
     let dq = orient3d(a, b, c, q);
     let (sp, sq) = (crate::geom::sign(dp), crate::geom::sign(dq));
@@ -1000,12 +1039,17 @@ fn segment_meets(p: DVec3, q: DVec3, a: DVec3, b: DVec3, c: DVec3) -> Option<(f6
             if has(Ordering::Less) && has(Ordering::Greater) {
                 false
             } else {
-                let proper = !has(Ordering::Equal);
-                return Some(((dp / (dp - dq)).clamp(0.0, 1.0), proper));
+                // orient3d is positive in front of the triangle: from front to back adds one.
+                let delta = match () {
+                    _ if has(Ordering::Equal) => 0,
+                    _ if dp > 0.0 => 1,
+                    _ => -1,
+                };
+                return Some(((dp / (dp - dq)).clamp(0.0, 1.0), delta));
             }
         }
     };
-    meets.then(|| (crossing_parameter(p, q, a, b, c, dp, dq), false))
+    meets.then(|| (crossing_parameter(p, q, a, b, c, dp, dq), 0))
 }
 
 /// Where [p, q] meets the plane of (a, b, c), from the two orientation determinants.

@@ -558,7 +558,7 @@ fn regions_of_nested_prisms() {
             continue;
         };
         assert_eq!(o.region(p), rp, "region of {p}");
-        if let Some(r) = o.region_across(rp, &o.crossings(p, q)) {
+        if let Some(r) = o.region_across(rp, &o.crossings(p, q), true) {
             assert_eq!(r, rq, "carried from {p} to {q}");
             checked += 1;
         }

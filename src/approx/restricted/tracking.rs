@@ -179,9 +179,9 @@ impl SurfaceMesher<'_> {
     ) -> u32 {
         let carried = |x: &[Crossing]| {
             if towards {
-                self.oracle.region_across(other, x)
+                self.oracle.region_across(other, x, true)
             } else {
-                self.oracle.region_across(other, x.iter().rev())
+                self.oracle.region_across(other, x.iter().rev(), false)
             }
         };
         match (centre, crossings) {
