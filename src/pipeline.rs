@@ -16,6 +16,13 @@ pub fn mesh(
     progress: Option<Progress>,
 ) -> Result<(TetMesh, Report), MeshError> {
     let (mesh, mut report) = match params.surface_mode {
+        SurfaceMode::Keep if params.repair => {
+            return Err(MeshError::InvalidInput(
+                "repair needs the approximate surface mode: keep mode preserves every input \
+                 facet exactly, which a dirty surface does not allow"
+                    .into(),
+            ))
+        }
         SurfaceMode::Keep => {
             let (mesh, mut report) = refine::mesh(input, params, spacing, progress)?;
             let mesh = crate::improve::finish(mesh, &mut report, Some(input), params, None)?;

@@ -25,6 +25,7 @@ pub const PARAM_NAMES: &[&str] = &[
     "feature_angle",
     "surface_distance",
     "improve_target",
+    "repair",
 ];
 
 /// Smallest accepted `rho0` (the refiner's own limit, `Params::check`).
@@ -48,8 +49,10 @@ const MAX_EXACT_INT: f64 = 9_007_199_254_740_992.0; // 2^53
 /// describe), `feature_angle` (degrees, in (0, 180): approximate mode's sharp-edge threshold),
 /// `surface_distance` (finite, >= 0: approximate mode's distance bound; 0 = the default, 0.001 x
 /// the bounding-box diagonal), `improve_target` (degrees in [0, 40]: improvement works on tets
-/// with a smaller dihedral angle; 0 = the mode's default, 26 keep / 20 approximate). Integer
-/// and 0/1 parameters must be given as whole numbers.
+/// with a smaller dihedral angle; 0 = the mode's default, 26 keep / 20 approximate), `repair`
+/// (0 or 1: approximate mode meshes a dirty surface, open, self-intersecting or overlapping,
+/// as the solid where its winding number is at least 1/2). Integer and 0/1 parameters must be
+/// given as whole numbers.
 /// The result also passes `Params::check` (the refiner's own validation), so a value accepted
 /// here is never refused by `refine`.
 pub fn set_param(params: &mut Params, name: &str, value: f64) -> Result<(), Error> {
@@ -179,6 +182,18 @@ fn set_unchecked(params: &mut Params, name: &str, value: f64) -> Result<(), Erro
             }
             params.improve_target = value;
         }
+        "repair" => {
+            params.repair = match value {
+                0.0 => false,
+                1.0 => true,
+                _ => {
+                    return invalid(format!(
+                        "repair = {value}: must be 1 (mesh a dirty surface as the solid where \
+                         its winding number is at least 1/2; approximate mode) or 0 (refuse it)"
+                    ))
+                }
+            }
+        }
         "refine" => {
             params.refine = match value {
                 0.0 => false,
@@ -223,6 +238,7 @@ pub fn get_param(params: &Params, name: &str) -> Result<f64, Error> {
         "feature_angle" => params.feature_angle,
         "surface_distance" => params.surface_distance,
         "improve_target" => params.improve_target,
+        "repair" => f64::from(u8::from(params.repair)),
         _ => {
             return invalid(format!(
                 "unknown parameter \"{name}\"; valid names: {}",
@@ -295,6 +311,7 @@ mod tests {
             ("feature_angle", 30.0),
             ("surface_distance", 0.01),
             ("improve_target", 30.0),
+            ("repair", 1.0),
         ];
         assert_eq!(values.len(), PARAM_NAMES.len());
         for (name, v) in values {
@@ -306,7 +323,9 @@ mod tests {
         assert!(!p.refine);
         assert!(!p.improve);
         assert_eq!(p.surface_mode, SurfaceMode::Approximate);
+        assert!(p.repair);
         assert!(set_param(&mut p, "improve", 0.5).is_err());
+        assert!(set_param(&mut p, "repair", 2.0).is_err());
     }
 
     #[test]

@@ -55,10 +55,23 @@ pub fn surface_report(r: &Remeshed, mesh: &TetMesh) -> SurfaceReport {
             volume(a, b, c, d)
         })
         .sum();
+    let mut out_samples = hausdorff_samples(&out);
+    let repair = r.repaired.as_ref().map(|repaired| {
+        // Where the boundary spans a hole no input is near: those samples measure nothing.
+        out_samples.retain(|&p| {
+            r.oracle.distance_beyond(p, r.distance).is_none() || !repaired.labels.spans_at(p)
+        });
+        let (boundary_area, spanned_area) = spanned_area(&out, &r.oracle, r.distance);
+        crate::surface::repair::Defects {
+            boundary_area,
+            spanned_area,
+            ..repaired.defects.clone()
+        }
+    });
     SurfaceReport {
         surface_distance: r.distance,
         hausdorff_input_to_output: one_sided(&r.input_samples, &SurfaceOracle::for_distances(&out)),
-        hausdorff_output_to_input: one_sided(&hausdorff_samples(&out), &r.oracle),
+        hausdorff_output_to_input: one_sided(&out_samples, &r.oracle),
         feature_distance: feature_distance(r, &mesh.vertices),
         relative_volume_difference: if r.input_volume > 0.0 {
             (out_volume - r.input_volume) / r.input_volume
@@ -77,7 +90,19 @@ pub fn surface_report(r: &Remeshed, mesh: &TetMesh) -> SurfaceReport {
         n_surface_vertices: r.boundary.vertices.len(),
         n_surface_triangles: r.boundary.facets.len(),
         seconds_surface: r.seconds,
+        repair,
     }
+}
+
+/// The area of `out`, and of its triangles whose centroid lies farther than `bound` from the
+/// surface behind `oracle`.
+fn spanned_area(out: &InputSurface, oracle: &SurfaceOracle, bound: f64) -> (f64, f64) {
+    (0..out.triangles.len()).fold((0.0, 0.0), |(all, far), t| {
+        let [a, b, c] = out.corners(t);
+        let area = 0.5 * (b - a).cross(c - a).length();
+        let spans = oracle.distance_beyond((a + b + c) / 3.0, bound).is_some();
+        (all + area, far + if spans { area } else { 0.0 })
+    })
 }
 
 /// The output boundary, its triangles along a Hilbert curve: consecutive samples then lie

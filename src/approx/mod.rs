@@ -29,10 +29,11 @@ use crate::refine::{
 };
 use crate::surface::features::{FeatureParams, Features};
 use crate::surface::oracle::SurfaceOracle;
+use crate::surface::repair::Repaired;
 use crate::surface::thickness::Thickness;
 use crate::surface::InputSurface;
 use curves::FeatureCurves;
-use restricted::{SurfaceCriteria, SurfaceMesher, VolumeCriteria, VolumeMesh};
+use restricted::{Geometry, SurfaceCriteria, SurfaceMesher, VolumeCriteria, VolumeMesh};
 
 /// Default spacing of the boundary when the caller gives none, as a share of the bounding-box
 /// diagonal (curved patches get finer through the distance bound, the volume is graded from
@@ -84,6 +85,8 @@ pub struct Remeshed {
     pub region_attributes: Vec<i32>,
     /// The input's region volumes and interface area (`Plc::input_regions`).
     pub input_regions: crate::plc::InputRegions,
+    /// A repaired input's solid (`--repair`).
+    pub repaired: Option<Box<Repaired>>,
     pub n_corners: usize,
     /// Small corners: point and protecting radius (the influence the report counts in).
     pub small_corners: Vec<(glam::DVec3, f64)>,
@@ -313,8 +316,8 @@ pub fn remesh(
 ) -> Result<(Remeshed, VolumeMesh), MeshError> {
     let start = std::time::Instant::now();
     params.check().map_err(MeshError::InvalidInput)?;
-    let plc = crate::plc::validate(input).map_err(|e| MeshError::InvalidInput(e.to_string()))?;
-    let surface = InputSurface::from_plc(&plc);
+    let source = Source::read(input, params)?;
+    let surface = source.surface();
     let diagonal = surface.bbox_diagonal();
     let default_spacing = ConstantSpacing(DEFAULT_SPACING_FRACTION * diagonal);
     let f: &dyn Spacing = spacing.unwrap_or(&default_spacing);
@@ -323,10 +326,15 @@ pub fn remesh(
         &surface,
         &FeatureParams {
             feature_angle: params.feature_angle,
-            use_markers: has_labels(input),
+            use_markers: !params.repair && has_labels(input),
+            borders: !params.repair,
         },
         &mut |p| f.at(p),
     );
+    let (mut features, noise) = (features, noise);
+    if let Some(r) = source.repaired() {
+        r.join_patches_across_intersections(&mut features);
+    }
     let mut curves = FeatureCurves::new(&surface, &features);
     let distance = if params.surface_distance > 0.0 {
         params.surface_distance
@@ -345,15 +353,14 @@ pub fn remesh(
         thickness_spacing: THICKNESS_SPACING,
         seed: params.seed,
     };
-    let mesher = SurfaceMesher::new(
-        &surface,
-        &oracle,
-        &curves,
-        &features.patch_of,
-        f,
-        Some(&thickness),
-        criteria,
-    )?;
+    let geometry = Geometry {
+        surface: &surface,
+        oracle: &oracle,
+        curves: &curves,
+        patch_of: &features.patch_of,
+        repair: source.repaired(),
+    };
+    let mesher = SurfaceMesher::new(geometry, f, Some(&thickness), criteria)?;
     let (mut b, volume) = mesher.run_with_volume(crit, progress)?;
 
     let boundary = boundary_plc(input, &b, &surface, &features);
@@ -370,9 +377,10 @@ pub fn remesh(
         input_samples,
         small_corner_vertices,
         vertex_slide,
-        input_volume: plc.volume(),
-        region_attributes: plc.region_attributes(),
-        input_regions: plc.input_regions(),
+        input_volume: source.volume(),
+        region_attributes: source.region_attributes(),
+        input_regions: source.input_regions(),
+        repaired: source.into_repaired(),
         n_corners: curves.corners.len(),
         curves,
         small_corners,
@@ -387,6 +395,97 @@ pub fn remesh(
         seconds: start.elapsed().as_secs_f64(),
     };
     Ok((remeshed, volume))
+}
+
+/// The input as the approximate mode reads it: a checked PLC, or with `--repair` a dirty
+/// surface's solid.
+enum Source {
+    Checked(crate::plc::Plc),
+    Repaired(Box<Repaired>),
+}
+
+impl Source {
+    fn read(input: &PlcInput, params: &Params) -> Result<Source, MeshError> {
+        if params.repair {
+            return Repaired::new(input)
+                .map(|r| Source::Repaired(Box::new(r)))
+                .map_err(|e| MeshError::InvalidInput(format!("repair: {e}")));
+        }
+        crate::plc::validate(input)
+            .map(Source::Checked)
+            .map_err(|e| MeshError::InvalidInput(with_repair_hint(e)))
+    }
+
+    /// The triangles the boundary approximates.
+    fn surface(&self) -> InputSurface {
+        match self {
+            Source::Checked(plc) => InputSurface::from_plc(plc),
+            Source::Repaired(r) => r.surface.clone(),
+        }
+    }
+
+    fn repaired(&self) -> Option<&Repaired> {
+        match self {
+            Source::Checked(_) => None,
+            Source::Repaired(r) => Some(r),
+        }
+    }
+
+    /// The enclosed volume (0, unknown, for a repaired input: the report then gives no
+    /// relative difference).
+    fn volume(&self) -> f64 {
+        match self {
+            Source::Checked(plc) => plc.volume(),
+            Source::Repaired(_) => 0.0,
+        }
+    }
+
+    /// Per region, its output attribute (a repaired input's solid is one region, 0).
+    fn region_attributes(&self) -> Vec<i32> {
+        match self {
+            Source::Checked(plc) => plc.region_attributes(),
+            Source::Repaired(_) => vec![0],
+        }
+    }
+
+    fn input_regions(&self) -> crate::plc::InputRegions {
+        match self {
+            Source::Checked(plc) => plc.input_regions(),
+            Source::Repaired(_) => crate::plc::InputRegions {
+                volumes: vec![(0, 0.0)],
+                interface_area: 0.0,
+            },
+        }
+    }
+
+    fn into_repaired(self) -> Option<Box<Repaired>> {
+        match self {
+            Source::Checked(_) => None,
+            Source::Repaired(r) => Some(r),
+        }
+    }
+}
+
+/// A validation error's message, with the hint that `--repair` meshes such a surface where
+/// it would (the surface is open, self-intersecting or has duplicate vertices).
+fn with_repair_hint(e: crate::plc::PlcError) -> String {
+    use crate::plc::PlcError::*;
+    let message = e.to_string();
+    match e {
+        DuplicateVertex { .. }
+        | FacetsIntersect { .. }
+        | FacetsMeetOffSegment { .. }
+        | SurfaceNotClosed { .. }
+        | VertexOnFacet { .. }
+        | NonPlanarFacet { .. }
+        | DegenerateFacet { .. }
+        | RepeatedVertex { .. }
+        | EdgesIntersect { .. } => format!(
+            "{message} (--repair meshes open, self-intersecting and overlapping surfaces as \
+             the solid their winding number encloses)"
+        ),
+        _ => message,
+    }
 }
 
 /// The boundary vertices in a small corner's protecting ball, where the surface mesher left

@@ -35,6 +35,7 @@ use crate::geom::tri_circumcenter;
 use crate::refine::outcome::{BoundaryKind, Outcome, Refusal};
 use crate::refine::{MeshError, Spacing};
 use crate::surface::oracle::{Crossing, SurfaceOracle};
+use crate::surface::repair::{Repaired, HIDDEN};
 use crate::surface::thickness::Thickness;
 use crate::surface::InputSurface;
 use glam::DVec3;
@@ -80,6 +81,8 @@ pub enum Loc {
     Patch(u32),
     /// Inserted by the cell level, inside the domain.
     Volume,
+    /// On the boundary of a repaired solid where it spans a hole of the input (`--repair`).
+    Span,
 }
 
 /// A piece of a feature curve between two consecutive vertices on it.
@@ -98,7 +101,10 @@ pub(crate) struct Restricted {
     vertices: [u32; 3],
     centre: DVec3,
     radius: f64,
+    /// The input triangle the centre lies on (nearest to it when `span`).
     triangle: u32,
+    /// The centre spans a hole of a repaired input: it lies on no input triangle.
+    span: bool,
 }
 
 /// A face of the triangulation: a tet and the local index of the vertex opposite the face.
@@ -159,11 +165,26 @@ pub struct Boundary {
     pub input_samples: Option<Vec<DVec3>>,
 }
 
+/// What the surface mesher approximates.
+#[derive(Clone, Copy)]
+pub struct Geometry<'a> {
+    pub surface: &'a InputSurface,
+    /// The oracle of `surface`.
+    pub oracle: &'a SurfaceOracle,
+    pub curves: &'a FeatureCurves,
+    /// Smooth patch of each triangle of `surface`.
+    pub patch_of: &'a [u32],
+    /// A dirty input's solid (`--repair`): inside and outside come from its labels, and
+    /// `surface` holds its triangles that bound it.
+    pub repair: Option<&'a Repaired>,
+}
+
 pub struct SurfaceMesher<'a> {
     surface: &'a InputSurface,
     oracle: &'a SurfaceOracle,
     curves: &'a FeatureCurves,
     patch_of: &'a [u32],
+    repair: Option<&'a Repaired>,
     spacing: &'a dyn Spacing,
     criteria: SurfaceCriteria,
     dt: Delaunay,
@@ -188,6 +209,8 @@ pub struct SurfaceMesher<'a> {
     input_samples: std::cell::OnceCell<Vec<DVec3>>,
     /// The thickness bound of the surface spacing, if a thickness was given.
     thin: Option<ThinBound>,
+    /// Samples a repaired input's boundary was mended at (`rounds`), by coordinate bits.
+    mended: FxHashSet<[u64; 3]>,
 }
 
 /// The surface spacing's bound by the input's thickness, per input triangle.
@@ -250,20 +273,25 @@ fn has_angle_below(a: DVec3, b: DVec3, c: DVec3, min_deg: f64) -> bool {
 impl<'a> SurfaceMesher<'a> {
     /// Samples the corners, curves and patches and triangulates the samples.
     pub fn new(
-        surface: &'a InputSurface,
-        oracle: &'a SurfaceOracle,
-        curves: &'a FeatureCurves,
-        patch_of: &'a [u32],
+        geometry: Geometry<'a>,
         spacing: &'a dyn Spacing,
         thickness: Option<&Thickness>,
         criteria: SurfaceCriteria,
     ) -> Result<SurfaceMesher<'a>, MeshError> {
+        let Geometry {
+            surface,
+            oracle,
+            curves,
+            patch_of,
+            repair,
+        } = geometry;
         let diagonal = surface.bbox_diagonal();
         let mut m = SurfaceMesher {
             surface,
             oracle,
             curves,
             patch_of,
+            repair,
             spacing,
             criteria,
             dt: Delaunay::default(),
@@ -279,6 +307,7 @@ impl<'a> SurfaceMesher<'a> {
             track: tracking::Tracking::default(),
             vol: None,
             input_samples: std::cell::OnceCell::new(),
+            mended: FxHashSet::default(),
             thin: thickness.map(|t| ThinBound {
                 per_triangle: t.per_triangle(surface),
                 scale: criteria.thickness_spacing,
@@ -426,6 +455,13 @@ impl<'a> SurfaceMesher<'a> {
                 if grid.has_within(p, r) {
                     continue;
                 }
+                // A repaired input's triangle may bound the solid in part only.
+                if self
+                    .repair
+                    .is_some_and(|rep| !rep.bounds_solid_at(p, self.surface.normal(t)))
+                {
+                    continue;
+                }
                 grid.add(p);
                 points.push(p);
                 self.loc.push(Loc::Patch(self.patch_of[t]));
@@ -461,6 +497,7 @@ impl<'a> SurfaceMesher<'a> {
             return Err(MeshError::Cancelled);
         }
         let mut boundary = self.boundary(faces, stop_reason);
+        self.input_samples();
         boundary.input_samples = self.input_samples.take();
         let mut volume = self.volume_mesh(&boundary)?;
         volume.spacing = self.vol.take().and_then(|v| v.spacing);
@@ -487,6 +524,11 @@ impl<'a> SurfaceMesher<'a> {
                 let mut far = self.far_from_input(&faces);
                 if far.is_empty() {
                     far = self.far_from_surface(&faces);
+                }
+                if self.repair.is_some() {
+                    // An intersection's crease or sliver may stay beyond the bound where its
+                    // own points went in: each sample is mended once.
+                    far.retain(|f| self.mended.insert(f.2.to_array().map(f64::to_bits)));
                 }
                 far
             } else {
@@ -517,7 +559,15 @@ impl<'a> SurfaceMesher<'a> {
                 let Some([(t, i), _]) = self.dt.find_face(face[0], face[1], face[2]) else {
                     continue;
                 };
-                if let Some(r) = self.facet_at(t, i) {
+                // A repaired input's sample far from the boundary lies on a bounding piece of
+                // the input (an overlap's thin sliver): the sample itself goes in.
+                let repaired_sample = sample.filter(|_| self.repair.is_some());
+                if let (Some(p), Some(c)) = (
+                    repaired_sample,
+                    repaired_sample.and_then(|p| self.oracle.closest(p)),
+                ) {
+                    self.insert_input_point(p, c.triangle, face, t);
+                } else if let Some(r) = self.facet_at(t, i) {
                     self.insert_surface_point(r, t, Bad::Boundary);
                 } else if let Some(c) = self
                     .oracle
@@ -543,6 +593,7 @@ impl<'a> SurfaceMesher<'a> {
             centre: p,
             radius: 0.0,
             triangle,
+            span: false,
         };
         self.insert_surface_point(r, hint, Bad::Boundary);
     }
@@ -692,28 +743,70 @@ impl<'a> SurfaceMesher<'a> {
             return None;
         }
         let face = FACE[i].map(|k| self.dt.tet(t)[k]);
-        let &(centre, radius, triangle) = self.track.restricted.get(&key3(face))?;
+        let &(centre, radius, triangle, span) = self.track.restricted.get(&key3(face))?;
         Some(Restricted {
             vertices: face,
             centre,
             radius,
             triangle,
+            span,
         })
     }
 
-    /// Face `face` as a restricted facet, given where its Voronoi edge crosses the surface:
-    /// the crossing farthest from its vertices is its surface centre.
-    fn facet_from(dt: &Delaunay, face: [u32; 3], crossings: Vec<Crossing>) -> Option<Restricted> {
-        let a = dt.point(face[0]);
-        let best = crossings
-            .into_iter()
-            .map(|x| ((x.point - a).length(), x))
-            .max_by(|x, y| x.0.total_cmp(&y.0))?;
+    /// Face `face` as a restricted facet, given where its Voronoi edge crosses the surface
+    /// (`crossings`, from the segment's start `ends.0` in region `ends.1` to its end `ends.2`
+    /// in region `ends.3`): the crossing farthest from its vertices is its surface centre.
+    /// For a repaired input only the points where the label changes count.
+    fn facet_from(
+        &self,
+        face: [u32; 3],
+        crossings: Vec<Crossing>,
+        ends: Option<(DVec3, u32, DVec3, u32)>,
+    ) -> Option<Restricted> {
+        let a = self.dt.point(face[0]);
+        let farthest = |points: Vec<(DVec3, Option<u32>)>| {
+            points
+                .into_iter()
+                .map(|(p, t)| ((p - a).length(), p, t))
+                .max_by(|x, y| x.0.total_cmp(&y.0))
+        };
+        let Some(repair) = self.repair else {
+            let points = crossings
+                .iter()
+                .map(|x| (x.point, Some(x.triangle)))
+                .collect();
+            let (radius, centre, triangle) = farthest(points)?;
+            return Some(Restricted {
+                vertices: face,
+                centre,
+                radius,
+                triangle: triangle.unwrap_or(0),
+                span: false,
+            });
+        };
+        let (c, rc, cn, rn) = ends?;
+        let labels = &repair.labels;
+        let points = match labels.boundary_points(c, cn, &crossings, tracking::count_of(rc)) {
+            Some(b) => b.into_iter().map(|b| (b.point, b.triangle)).collect(),
+            // Crossings through edges: the labels at the ends say whether it is restricted.
+            None if tracking::label_of(rc) != tracking::label_of(rn) => crossings
+                .iter()
+                .map(|x| (x.point, labels.is_input(x.triangle).then_some(x.triangle)))
+                .collect(),
+            None => vec![],
+        };
+        let (radius, centre, on) = farthest(points)?;
+        let triangle = on
+            .map(|t| repair.surface_id[t as usize])
+            .filter(|&t| t != HIDDEN)
+            .or_else(|| self.oracle.closest(centre).map(|c| c.triangle))
+            .unwrap_or(0);
         Some(Restricted {
             vertices: face,
-            centre: best.1.point,
-            radius: best.0,
-            triangle: best.1.triangle,
+            centre,
+            radius,
+            triangle,
+            span: on.is_none(),
         })
     }
 
@@ -725,6 +818,7 @@ impl<'a> SurfaceMesher<'a> {
     fn on_patch(&self, v: u32, patch: u32) -> bool {
         match self.loc[v as usize] {
             Loc::Far | Loc::Volume => false,
+            Loc::Span => true,
             Loc::Patch(p) => p == patch,
             Loc::Curve(c) => self.curves.curves[c as usize].patches.contains(&patch),
             Loc::Corner(k) => self.curves.corners[k as usize].patches.contains(&patch),
@@ -740,10 +834,11 @@ impl<'a> SurfaceMesher<'a> {
     fn badness(&mut self, r: &Restricted) -> Bad {
         let patch = self.patch_of[r.triangle as usize];
         let above_floor = r.radius >= self.criteria.feature_floor;
-        if above_floor && !r.vertices.iter().all(|&v| self.on_patch(v, patch)) {
+        // A hole's span belongs to no patch.
+        if above_floor && !r.span && !r.vertices.iter().all(|&v| self.on_patch(v, patch)) {
             return Bad::Topology;
         }
-        if r.radius > self.f_on(r.centre, Some(r.triangle)) {
+        if r.radius > self.f_on(r.centre, (!r.span).then_some(r.triangle)) {
             return Bad::Size;
         }
         let [a, b, c] = r.vertices.map(|v| self.dt.point(v));
@@ -757,15 +852,17 @@ impl<'a> SurfaceMesher<'a> {
         }
         // The circumcentre sees the surface along one line only; across a crease below the
         // feature angle the triangle strays farther elsewhere (measured on spool: 1.13x the
-        // bound at a 13-degree ridge). Its centroid's distance catches that.
-        if self
-            .oracle
-            .distance_beyond_hinted(
-                (a + b + c) / 3.0,
-                self.criteria.distance,
-                &mut Some(r.triangle),
-            )
-            .is_some()
+        // bound at a 13-degree ridge). Its centroid's distance catches that (not over a
+        // hole, where no input is near).
+        if !r.span
+            && self
+                .oracle
+                .distance_beyond_hinted(
+                    (a + b + c) / 3.0,
+                    self.criteria.distance,
+                    &mut Some(r.triangle),
+                )
+                .is_some()
         {
             return Bad::Distance;
         }
@@ -825,8 +922,11 @@ impl<'a> SurfaceMesher<'a> {
         let Ok(Inserted::New(id)) = self.dt.insert_cavity(cavity) else {
             return Outcome::Refused(Refusal::Duplicate);
         };
-        self.loc
-            .push(Loc::Patch(self.patch_of[r.triangle as usize]));
+        self.loc.push(if r.span {
+            Loc::Span
+        } else {
+            Loc::Patch(self.patch_of[r.triangle as usize])
+        });
         debug_assert_eq!(self.loc.len(), id as usize + 1);
         self.after_insertion();
         Outcome::Split(BoundaryKind::Facet)

@@ -69,6 +69,11 @@ pub struct MeshOptions {
     /// length; default 0.001 x the input's bounding-box diagonal).
     #[arg(long, value_name = "D", allow_negative_numbers = true)]
     pub surface_distance: Option<f64>,
+    /// Approximate mode: mesh a dirty surface (holes, cracks, self-intersections, overlapping
+    /// shells, flipped or duplicated triangles) as the solid where its generalized winding
+    /// number is at least 1/2, instead of refusing it. The report says what was wrong.
+    #[arg(long)]
+    pub repair: bool,
     /// Write the binary form of the output format where it has one (.msh: gmsh 4.1 binary;
     /// .vtu: binary appended arrays); the other formats are written as usual.
     #[arg(long)]
@@ -110,6 +115,7 @@ impl MeshOptions {
             refine: !self.no_refine,
             improve: !self.no_improve,
             surface_mode: self.surface_mode(input),
+            repair: self.repair,
             ..Params::default()
         };
         if let Some(v) = self.feature_angle {

@@ -26,7 +26,10 @@ use std::ffi::{c_char, c_void};
 /// "surface_distance" (approximate mode: finite, >= 0, absolute length; 0, the default, means
 /// 0.001 x the input's bounding-box diagonal), "improve_target" (degrees in [0, 40]:
 /// improvement works on tets with a smaller dihedral angle; 0, the default, means 26 in keep
-/// mode and 20 in approximate mode).
+/// mode and 20 in approximate mode), "repair" (approximate mode: 1 meshes a dirty surface,
+/// open, self-intersecting, overlapping or with duplicated triangles, as the solid where its
+/// generalized winding number is at least 1/2; 0, the default, refuses it with the error that
+/// names the defect).
 /// An unknown name or out-of-range value gives `SM_ERR_INVALID_ARGUMENT`; `sm_last_error`
 /// says why (and lists the valid names).
 ///

@@ -75,6 +75,10 @@ pub struct Params {
     /// approximate mode, whose finer boundaries make 26 cost about 8x the improvement time
     /// (see `effective_improve_target`).
     pub improve_target: f64,
+    /// Approximate mode: mesh a dirty surface (open, self-intersecting, overlapping, flipped,
+    /// duplicated) as the solid where its generalized winding number is at least 1/2
+    /// (`crate::surface::repair`) instead of refusing it.
+    pub repair: bool,
 }
 
 /// Default improvement target (degrees) in keep mode: every acute-free model reaches 25.
@@ -117,6 +121,7 @@ impl Default for Params {
             feature_angle: 40.0,
             surface_distance: 0.0,
             improve_target: 0.0,
+            repair: false,
         }
     }
 }
@@ -355,6 +360,10 @@ pub struct SurfaceReport {
     pub n_surface_triangles: usize,
     /// Time spent building the boundary (feature protection and restricted Delaunay facets).
     pub seconds_surface: f64,
+    /// With `--repair`: what was wrong with the input and what the output spans. The
+    /// Hausdorff distance out->in then leaves the spanned holes out.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub repair: Option<crate::surface::repair::Defects>,
 }
 
 /// Why meshing failed.

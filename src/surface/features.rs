@@ -43,6 +43,10 @@ pub struct FeatureParams {
     /// Whether a change of facet marker makes an edge a feature (true for inputs whose markers
     /// are labels: .poly/.smesh markers, named STL solids).
     pub use_markers: bool,
+    /// Whether border and non-manifold edges are features (false for a repaired input's
+    /// bounding triangles, whose borders are holes spanned smoothly and the edges where a
+    /// hidden part was left out).
+    pub borders: bool,
 }
 
 impl Default for FeatureParams {
@@ -50,6 +54,7 @@ impl Default for FeatureParams {
         FeatureParams {
             feature_angle: 40.0,
             use_markers: false,
+            borders: true,
         }
     }
 }
@@ -173,7 +178,8 @@ enum Sharp {
 fn sharpness(s: &InputSurface, p: &FeatureParams, uses: &[EdgeUse]) -> Sharp {
     let [u1, u2] = match uses {
         [u1, u2] => [*u1, *u2],
-        _ => return Sharp::Structural,
+        _ if p.borders => return Sharp::Structural,
+        _ => return Sharp::No,
     };
     let (t1, t2) = (u1.1 as usize, u2.1 as usize);
     if s.facet_of[t1] == s.facet_of[t2] {

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod corpus;
+pub mod dirty;
 
 use slivermesh::geom::{insphere, orient3d};
 use slivermesh::mesh::TetMesh;

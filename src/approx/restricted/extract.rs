@@ -82,9 +82,7 @@ impl SurfaceMesher<'_> {
     pub(super) fn far_from_input(&self, faces: &[FaceRef]) -> Vec<(u32, usize, DVec3)> {
         let extracted = self.extracted_surface(faces);
         let near = SurfaceOracle::for_distances(&extracted);
-        let points = self
-            .input_samples
-            .get_or_init(|| crate::approx::measure::hausdorff_samples(self.surface));
+        let points = self.input_samples();
         // Consecutive samples come from one input triangle: the last face found is tried first.
         let mut hint = None;
         let far: Vec<Far> = points
@@ -119,6 +117,7 @@ impl SurfaceMesher<'_> {
                     .is_some()
             })
             .filter(|&p| !self.near_small_corner(p))
+            .filter(|&p| self.repair.is_none_or(|r| !r.labels.spans_at(p)))
             .collect();
         if far_samples.is_empty() {
             return vec![];
@@ -132,6 +131,25 @@ impl SurfaceMesher<'_> {
             })
             .collect();
         farthest_per_face(far)
+    }
+
+    /// The input's Hausdorff samples (`measure::hausdorff_samples`), once taken; of a repaired
+    /// input, those where it bounds the solid.
+    pub(super) fn input_samples(&self) -> &[DVec3] {
+        self.input_samples.get_or_init(|| {
+            let all = crate::approx::measure::hausdorff_samples(self.surface);
+            match self.repair {
+                None => all,
+                Some(r) => all
+                    .into_iter()
+                    .filter(|&p| {
+                        self.oracle.closest(p).is_some_and(|c| {
+                            r.bounds_solid_at(p, self.surface.normal(c.triangle as usize))
+                        })
+                    })
+                    .collect(),
+            }
+        })
     }
 
     /// The faces as a surface over the triangulation's points (for distance queries).

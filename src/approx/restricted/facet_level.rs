@@ -53,7 +53,7 @@ impl FacetLevel for SurfaceMesher<'_> {
                     continue;
                 }
                 let key = key3(face);
-                if let Some(&(centre, radius, _)) = self.track.restricted.get(&key) {
+                if let Some(&(centre, radius, _, _)) = self.track.restricted.get(&key) {
                     if (p - centre).length_squared() < radius * radius
                         && best.is_none_or(|b| radius > b.1)
                     {
@@ -125,6 +125,7 @@ mod tests {
         let params = FeatureParams {
             feature_angle: 40.0,
             use_markers: false,
+            borders: true,
         };
         let features = Features::detect(&surface, &params);
         let curves = FeatureCurves::new(&surface, &features);
@@ -139,16 +140,14 @@ mod tests {
             thickness_spacing: 1.0,
             seed: 1,
         };
-        let mut m = SurfaceMesher::new(
-            &surface,
-            &oracle,
-            &curves,
-            &features.patch_of,
-            &spacing,
-            None,
-            criteria,
-        )
-        .unwrap();
+        let geometry = crate::approx::restricted::Geometry {
+            surface: &surface,
+            oracle: &oracle,
+            curves: &curves,
+            patch_of: &features.patch_of,
+            repair: None,
+        };
+        let mut m = SurfaceMesher::new(geometry, &spacing, None, criteria).unwrap();
         let (_, stop) = m.rounds(&mut SurfaceMesher::refine).unwrap();
         assert!(stop.is_none());
         let probe = |m: &mut SurfaceMesher, p: DVec3| match m.dt.probe(p, None) {
@@ -161,7 +160,7 @@ mod tests {
             Conflict::Free
         ));
         // The largest restricted facet, and a point just inside its surface centre.
-        let (&face, &(c, radius, _)) = m
+        let (&face, &(c, radius, _, _)) = m
             .track
             .restricted
             .iter()

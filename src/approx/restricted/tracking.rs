@@ -13,13 +13,29 @@ use super::{key3, Queued, Restricted, SurfaceMesher};
 use crate::delaunay::tables::FACE;
 use crate::delaunay::{Delaunay, INFINITE};
 use crate::geom::circumsphere;
-use crate::surface::oracle::Crossing;
+use crate::surface::oracle::{Crossing, SurfaceOracle};
 use glam::DVec3;
 use rustc_hash::FxHashMap;
 
-/// A restricted facet's surface centre, surface-ball radius and the input triangle the centre
-/// lies on.
-pub(super) type SurfaceBall = (DVec3, f64, u32);
+/// A restricted facet's surface centre, surface-ball radius, the input triangle the centre
+/// lies on and whether it spans a hole instead (`Restricted`).
+pub(super) type SurfaceBall = (DVec3, f64, u32, bool);
+
+/// A repaired input's tet region: the winding count at the circumcentre and whether it lies
+/// in the solid, as `count * 2 + inside` (two's complement bits).
+fn repaired_region(count: i32, inside: bool) -> u32 {
+    ((count << 1) | i32::from(inside)) as u32
+}
+
+/// The winding count of a repaired input's region.
+pub(super) fn count_of(region: u32) -> i32 {
+    (region as i32) >> 1
+}
+
+/// Whether a repaired input's region is in the solid.
+pub(super) fn label_of(region: u32) -> u32 {
+    region & 1
+}
 
 /// Whether `face` was a restricted facet before the insertion (`before`: the records the
 /// removed tets' faces had).
@@ -69,7 +85,8 @@ pub(super) struct TetInfo {
     centre: DVec3,
     /// Negative when the tet has no circumsphere (flat or infinite).
     radius: f64,
-    /// The region holding the circumcentre (`InputSurface::sides`; 0 outside or without one).
+    /// The region holding the circumcentre (`InputSurface::sides`; 0 outside or without one);
+    /// for a repaired input, `repaired_region`.
     region: u32,
     /// Bit i: face i (opposite vertex i) is a key of [`Tracking::restricted`]. Kept exact on
     /// both tets of each face, so that the faces of removed and probed tets that are not
@@ -127,7 +144,7 @@ impl SurfaceMesher<'_> {
             restricted: classified
                 .restricted
                 .iter()
-                .map(|r| (key3(r.vertices), (r.centre, r.radius, r.triangle)))
+                .map(|r| (key3(r.vertices), (r.centre, r.radius, r.triangle, r.span)))
                 .collect(),
         };
         for r in classified.restricted {
@@ -155,7 +172,28 @@ impl SurfaceMesher<'_> {
 
     /// The region holding tet `t`'s circumcentre (0 outside).
     pub(super) fn region_of(&self, t: u32) -> u32 {
-        self.track.tets.get(t as usize).map_or(0, |i| i.region)
+        let region = self.track.tets.get(t as usize).map_or(0, |i| i.region);
+        match self.repair {
+            Some(_) => label_of(region),
+            None => region,
+        }
+    }
+
+    /// The oracle of the segment queries: the repaired input's counting surface, else the
+    /// surface's own.
+    fn segments(&self) -> &SurfaceOracle {
+        self.repair.map_or(self.oracle, |r| &r.labels.segments)
+    }
+
+    /// The region (as tracked) of a point, from a ray.
+    fn region_at(&self, p: DVec3) -> u32 {
+        match self.repair {
+            Some(r) => {
+                let count = r.labels.count(p);
+                repaired_region(count, r.labels.inside(count, p))
+            }
+            None => self.oracle.region(p),
+        }
     }
 
     /// The circumcentre and circumradius of live tet `t` (None when flat or infinite), as
@@ -177,17 +215,28 @@ impl SurfaceMesher<'_> {
         crossings: Option<&[Crossing]>,
         towards: bool,
     ) -> u32 {
+        let from = match self.repair {
+            Some(_) => count_of(other) as u32,
+            None => other,
+        };
         let carried = |x: &[Crossing]| {
-            if towards {
-                self.oracle.region_across(other, x, true)
+            let region = if towards {
+                self.segments().region_across(from, x, true)
             } else {
-                self.oracle.region_across(other, x.iter().rev(), false)
+                self.segments().region_across(from, x.iter().rev(), false)
+            };
+            match (self.repair, centre) {
+                (Some(r), Some(c)) => region.map(|n| {
+                    let count = n as i32;
+                    repaired_region(count, r.labels.inside(count, c))
+                }),
+                _ => region,
             }
         };
         match (centre, crossings) {
             (None, _) => 0,
-            (Some(c), Some(x)) => carried(x).unwrap_or_else(|| self.oracle.region(c)),
-            (Some(c), None) => self.oracle.region(c),
+            (Some(c), Some(x)) => carried(x).unwrap_or_else(|| self.region_at(c)),
+            (Some(c), None) => self.region_at(c),
         }
     }
 
@@ -262,44 +311,58 @@ impl SurfaceMesher<'_> {
         }
         std::hint::black_box(across);
         let mut found = vec![];
-        for &t in created {
-            let tv = self.dt.tet(t);
-            let nb = self.dt.neighbors(t);
-            let c = track.tets[t as usize].centre();
-            for i in 0..4 {
-                let n = nb[i];
-                let outer = tv[i] == new_vertex;
-                if !outer && n < t {
-                    continue; // an inner face of the new star, seen from the other tet
-                }
-                // Infinite tets have no centre: the neighbour's record alone says it.
-                let other = track.tets[n as usize];
-                let face = FACE[i].map(|k| tv[k]);
-                let both_centred = c.is_some() && other.centre().is_some();
-                if outer && both_centred && removed_centred && !was_restricted(&before, face) {
-                    // The new Voronoi edge is the part of the old one outside the new vertex's
-                    // cell: the old one crossed nothing, so neither does it (even parity).
-                    track.tets[t as usize].region = other.region;
-                    track.mark_face(&self.dt, t, i, false);
-                    continue;
-                }
-                let crossings = match (c, other.centre()) {
-                    (Some(c), Some(cn)) => Some(self.oracle.crossings(c, cn)),
-                    _ => None,
-                };
-                if outer {
-                    track.tets[t as usize].region =
-                        self.region_across(other.region, c, crossings.as_deref(), false);
-                }
-                let crossings = crossings.unwrap_or_default();
-                let restricted = Self::facet_from(&self.dt, face, crossings);
-                track.mark_face(&self.dt, t, i, restricted.is_some());
-                if let Some(r) = restricted {
-                    let key = key3(r.vertices);
-                    let ball = (r.centre, r.radius, r.triangle);
-                    track.restricted.insert(key, ball);
-                    if !before.contains(&(key, ball)) {
-                        found.push(r);
+        // The faces across the cavity's boundary first: they give the created tets their
+        // regions, which the inner faces of a repaired input's new star need.
+        for outer_pass in [true, false] {
+            for &t in created {
+                let tv = self.dt.tet(t);
+                let nb = self.dt.neighbors(t);
+                let c = track.tets[t as usize].centre();
+                for i in 0..4 {
+                    let n = nb[i];
+                    let outer = tv[i] == new_vertex;
+                    if outer != outer_pass || (!outer && n < t) {
+                        continue; // an inner face of the new star, seen from the other tet
+                    }
+                    // Infinite tets have no centre: the neighbour's record alone says it.
+                    let other = track.tets[n as usize];
+                    let face = FACE[i].map(|k| tv[k]);
+                    let both_centred = c.is_some() && other.centre().is_some();
+                    // (Not for a repaired input: its restricted facets are where the label changes,
+                    // and the old edge may have crossed triangles inside or outside the solid.)
+                    if outer
+                        && self.repair.is_none()
+                        && both_centred
+                        && removed_centred
+                        && !was_restricted(&before, face)
+                    {
+                        // The new Voronoi edge is the part of the old one outside the new vertex's
+                        // cell: the old one crossed nothing, so neither does it (even parity).
+                        track.tets[t as usize].region = other.region;
+                        track.mark_face(&self.dt, t, i, false);
+                        continue;
+                    }
+                    let crossings = match (c, other.centre()) {
+                        (Some(c), Some(cn)) => Some(self.segments().crossings(c, cn)),
+                        _ => None,
+                    };
+                    if outer {
+                        track.tets[t as usize].region =
+                            self.region_across(other.region, c, crossings.as_deref(), false);
+                    }
+                    let ends = c
+                        .zip(other.centre())
+                        .map(|(c, cn)| (c, track.tets[t as usize].region, cn, other.region));
+                    let crossings = crossings.unwrap_or_default();
+                    let restricted = self.facet_from(face, crossings, ends);
+                    track.mark_face(&self.dt, t, i, restricted.is_some());
+                    if let Some(r) = restricted {
+                        let key = key3(r.vertices);
+                        let ball = (r.centre, r.radius, r.triangle, r.span);
+                        track.restricted.insert(key, ball);
+                        if !before.contains(&(key, ball)) {
+                            found.push(r);
+                        }
                     }
                 }
             }
@@ -347,8 +410,11 @@ impl SurfaceMesher<'_> {
             .map(|&c| (c - middle).length())
             .fold(0.0, f64::max);
         // The distances are floating point: a relative margin far above their rounding.
-        self.oracle
-            .clear_within(middle, radius * (1.0 + UNTOUCHED_MARGIN))
+        let radius = radius * (1.0 + UNTOUCHED_MARGIN);
+        match self.repair {
+            Some(r) => r.labels.clear_within(middle, radius),
+            None => self.oracle.clear_within(middle, radius),
+        }
     }
 
     /// [`Classified`]: a walk from tet to neighbouring tet, where the segment between their
@@ -368,7 +434,7 @@ impl SurfaceMesher<'_> {
             out.tets[t as usize] = TetInfo::of(&self.dt, self.dt.tet(t));
             if queue.is_empty() {
                 if let Some(c) = out.tets[t as usize].centre() {
-                    out.tets[t as usize].region = self.oracle.region(c);
+                    out.tets[t as usize].region = self.region_at(c);
                     reached[t as usize] = true;
                     queue.push_back(t);
                 }
@@ -383,7 +449,7 @@ impl SurfaceMesher<'_> {
                 }
                 let (c, cn) = (out.tets[t as usize].centre(), out.tets[n as usize].centre());
                 let crossings = match (c, cn) {
-                    (Some(c), Some(cn)) => Some(self.oracle.crossings(c, cn)),
+                    (Some(c), Some(cn)) => Some(self.segments().crossings(c, cn)),
                     _ => None,
                 };
                 if !reached[n as usize] {
@@ -396,9 +462,13 @@ impl SurfaceMesher<'_> {
                     );
                     queue.push_back(n);
                 }
+                let ends = c.zip(cn).map(|(c, cn)| {
+                    let info = &out.tets;
+                    (c, info[t as usize].region, cn, info[n as usize].region)
+                });
                 let crossings = crossings.unwrap_or_default();
                 let face = FACE[i].map(|k| tv[k]);
-                if let Some(r) = Self::facet_from(&self.dt, face, crossings) {
+                if let Some(r) = self.facet_from(face, crossings, ends) {
                     out.restricted.push(r);
                     let (n, j) = self.dt.mirror(t, i);
                     out.tets[t as usize].restricted |= 1 << i;

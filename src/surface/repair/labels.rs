@@ -80,6 +80,16 @@ impl SolidLabels {
         self.winding(count, p) >= 0.5
     }
 
+    /// Whether `p` lies where the solid's boundary spans a hole: w is neither near 0 nor near
+    /// 1 there (off the input, w is within a quarter of an integer except near a hole).
+    pub fn spans_at(&self, p: DVec3) -> bool {
+        if self.holes.is_empty() || self.clear_of_fans(p, 0.0) {
+            return false;
+        }
+        let w = self.winding(self.count(p), p);
+        (w - w.round()).abs() > 0.25
+    }
+
     /// Whether some fan lies near enough to the segment [p, q] for w to pass 1/2 between two
     /// input triangles along it.
     pub fn near_fans(&self, p: DVec3, q: DVec3) -> bool {

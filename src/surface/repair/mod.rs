@@ -52,6 +52,10 @@ pub struct Defects {
     pub holes: usize,
     /// Input triangles on no part of the solid's boundary (inside or outside it).
     pub hidden_triangles: usize,
+    /// What the output made of it: the area of its boundary, and of the part farther than
+    /// the distance bound from the input (where it spans holes).
+    pub boundary_area: f64,
+    pub spanned_area: f64,
 }
 
 impl Defects {
@@ -77,6 +81,10 @@ pub struct Repaired {
     /// Per triangle of the counting surface: its id in `surface`, or [`HIDDEN`].
     pub surface_id: Vec<u32>,
     pub defects: Defects,
+    /// `SIDE_OFFSET` as a length.
+    side_offset: f64,
+    /// Pairs of `surface` triangles that intersect (other than at shared vertices and edges).
+    clashing: Vec<[u32; 2]>,
 }
 
 /// Offset, as a share of the bounding-box diagonal, of the two points on either side of a
@@ -154,21 +162,65 @@ impl Repaired {
             components,
             holes: labels.n_holes(),
             hidden_triangles: n_input - surface.triangles.len(),
+            ..Defects::default()
         };
+        let clashing = clashing
+            .iter()
+            .map(|p| p.map(|t| surface_id[t as usize]))
+            .filter(|p| !p.contains(&HIDDEN))
+            .collect();
         Ok(Repaired {
+            clashing,
+            side_offset: SIDE_OFFSET * all.bbox_diagonal(),
             surface,
             labels,
             surface_id,
             defects,
         })
     }
+
+    /// Makes patches that meet where triangles intersect one patch: the solid's boundary
+    /// passes from one to the other there with no feature curve between them, so a facet
+    /// across that crease has vertices on both (features and their patches are otherwise the
+    /// input's).
+    pub fn join_patches_across_intersections(&self, features: &mut super::features::Features) {
+        let mut sets = crate::union_find::UnionFind::new(features.n_patches);
+        for &[a, b] in &self.clashing {
+            sets.union(features.patch_of[a as usize], features.patch_of[b as usize]);
+        }
+        let mut number = vec![u32::MAX; features.n_patches];
+        let mut n = 0;
+        for p in 0..features.n_patches as u32 {
+            let root = sets.find(p) as usize;
+            if number[root] == u32::MAX {
+                number[root] = n;
+                n += 1;
+            }
+        }
+        for p in &mut features.patch_of {
+            *p = number[sets.find(*p) as usize];
+        }
+        features.n_patches = n as usize;
+    }
+
+    /// Whether the input surface through `p` (normal `normal`) bounds the solid there: the
+    /// labels just in front and just behind differ.
+    pub fn bounds_solid_at(&self, p: DVec3, normal: DVec3) -> bool {
+        bounds_at(&self.labels, p, normal * self.side_offset)
+    }
+}
+
+/// Whether the labels at p + offset and p - offset differ.
+fn bounds_at(labels: &SolidLabels, p: DVec3, offset: DVec3) -> bool {
+    let (front, back) = (p + offset, p - offset);
+    labels.inside(labels.count(front), front) != labels.inside(labels.count(back), back)
 }
 
 /// Whether each input triangle bounds the solid somewhere: the labels just in front of and
 /// just behind it differ. Along a set of triangles joined by manifold edges that no other
 /// triangle crosses and no fan comes near, w on either side is one integer throughout, so
-/// one triangle of the set answers for all; the others are sampled at their centroid and
-/// near each corner.
+/// one triangle of the set answers for all; a triangle near a fan is judged at its centroid,
+/// and one that another triangle cuts is kept.
 fn bounding_triangles(
     all: &InputSurface,
     n_input: usize,
@@ -177,40 +229,25 @@ fn bounding_triangles(
     labels: &SolidLabels,
 ) -> Vec<bool> {
     let offset = SIDE_OFFSET * all.bbox_diagonal();
-    let mut alone = vec![true; n_input];
+    let mut cut = vec![false; n_input];
     for &[a, b] in clashing {
-        alone[a as usize] = false;
-        alone[b as usize] = false;
+        cut[a as usize] = true;
+        cut[b as usize] = true;
     }
-    for t in 0..n_input {
-        if alone[t] {
+    let near_fans: Vec<bool> = (0..n_input)
+        .map(|t| {
             let [a, b, c] = all.corners(t);
             let (centre, r) = ((a + b + c) / 3.0, (a - b).length().max((c - b).length()));
-            alone[t] = labels.clear_of_fans(centre, r);
-        }
-    }
-    let bounds_at = |t: usize, x: DVec3| {
-        let n = all.normal(t) * offset;
-        let (front, back) = (x + n, x - n);
-        labels.inside(labels.count(front), front) != labels.inside(labels.count(back), back)
-    };
-    let sampled = |t: usize| {
-        let [a, b, c] = all.corners(t);
-        let g = (a + b + c) / 3.0;
-        [
-            g,
-            (4.0 * a + b + c) / 6.0,
-            (a + 4.0 * b + c) / 6.0,
-            (a + b + 4.0 * c) / 6.0,
-        ]
-        .into_iter()
-        .any(|x| bounds_at(t, x))
-    };
+            !labels.clear_of_fans(centre, r)
+        })
+        .collect();
+    let alone = |t: usize| !cut[t] && !near_fans[t];
+    let bounds_at = |t: usize, x: DVec3| bounds_at(labels, x, all.normal(t) * offset);
     let input_triangles = &all.triangles[..n_input];
     let mut sets = crate::union_find::UnionFind::new(n_input);
     for u in orient::edge_uses(input_triangles).values() {
         if let [(t, _), (v, _)] = u[..] {
-            if alone[t as usize] && alone[v as usize] {
+            if alone(t as usize) && alone(v as usize) {
                 sets.union(t, v);
             }
         }
@@ -221,13 +258,19 @@ fn bounding_triangles(
             if flat[t] {
                 return false;
             }
-            if !alone[t] {
-                return sampled(t);
+            // A triangle cut by another may bound the solid along a sliver that no sample
+            // meets: it is kept (samples taken on it are still checked one by one).
+            if cut[t] {
+                return true;
+            }
+            let centroid = all.corners(t).iter().sum::<DVec3>() / 3.0;
+            if near_fans[t] {
+                return bounds_at(t, centroid);
             }
             let root = sets.find(t as u32);
             *answer_of_set
                 .entry(root)
-                .or_insert_with(|| bounds_at(t, all.corners(t).iter().sum::<DVec3>() / 3.0))
+                .or_insert_with(|| bounds_at(t, centroid))
         })
         .collect()
 }

@@ -1,7 +1,7 @@
 //! The input's polygons as one welded triangle soup: no check but that every index and
 //! coordinate is usable, because a dirty surface is what `--repair` is for.
 
-use crate::plc::PlcInput;
+use crate::plc::{Facet, PlcInput};
 use glam::DVec3;
 use rustc_hash::FxHashMap;
 
@@ -20,9 +20,7 @@ pub(super) struct Soup {
 }
 
 impl Soup {
-    /// Every outer polygon of every facet, cut into a fan from its first corner (the
-    /// approximate mode reads each polygon as a piece of a smooth surface; hole polygons and
-    /// lone points are left out), over welded vertices.
+    /// Every facet's triangles (`facet_triangles`) over welded vertices.
     pub fn of(input: &PlcInput) -> Result<Soup, String> {
         for (i, &p) in input.vertices.iter().enumerate() {
             crate::geom::check_coordinate(p)
@@ -59,16 +57,16 @@ impl Soup {
                          {n} vertices)"
                     ));
                 }
-                for w in poly.windows(2).skip(1) {
-                    let t = [poly[0], w[0], w[1]].map(|v| weld[v as usize]);
-                    if t[0] == t[1] || t[1] == t[2] || t[2] == t[0] {
-                        soup.degenerate_triangles += 1;
-                        continue;
-                    }
-                    soup.triangles.push(t);
-                    soup.facet_of.push(k as u32);
-                    soup.marker_of.push(f.marker);
+            }
+            for t in facet_triangles(k, f, &input.vertices) {
+                let t = t.map(|v| weld[v as usize]);
+                if t[0] == t[1] || t[1] == t[2] || t[2] == t[0] {
+                    soup.degenerate_triangles += 1;
+                    continue;
                 }
+                soup.triangles.push(t);
+                soup.facet_of.push(k as u32);
+                soup.marker_of.push(f.marker);
             }
         }
         if soup.triangles.is_empty() {
@@ -76,4 +74,17 @@ impl Soup {
         }
         Ok(soup)
     }
+}
+
+/// The triangles of facet `k`: its constrained triangulation where it is a valid planar
+/// polygon (with holes), else a fan over each outer polygon of three or more corners.
+fn facet_triangles(k: usize, f: &Facet, vertices: &[DVec3]) -> Vec<[u32; 3]> {
+    if let Ok(checked) = crate::plc::check_facet(k, f, vertices) {
+        return checked.triangles;
+    }
+    f.polygons
+        .iter()
+        .filter(|p| p.len() >= 3)
+        .flat_map(|p| p.windows(2).skip(1).map(|w| [p[0], w[0], w[1]]))
+        .collect()
 }
