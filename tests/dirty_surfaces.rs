@@ -921,3 +921,24 @@ fn corpus_area_share_helper_measures_known_cases() {
     let want = (6.0 - far) / 6.0;
     assert!((moved - want).abs() < 1e-3, "{moved} against {want}");
 }
+
+/// Keep mode preserves every input facet, which a dirty surface does not allow: `--repair`
+/// there is refused with a message saying which mode it needs, and nothing is written.
+#[test]
+fn repair_in_keep_mode_is_refused() {
+    let d = dirty::small_hole_sphere();
+    let dir = ScratchDir::new("repair-keep");
+    let input = dir.0.join(d.file_name());
+    std::fs::write(&input, d.file_text()).unwrap();
+    let mesh = dir.0.join("out.mesh");
+    let run = Command::new(env!("CARGO_BIN_EXE_slivermesh"))
+        .args(["mesh", "--surface", "keep", "--repair", "-o"])
+        .arg(&mesh)
+        .arg(&input)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("approximate surface mode"), "{stderr}");
+    assert!(!mesh.exists());
+}

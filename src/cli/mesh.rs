@@ -301,6 +301,31 @@ fn surface_table(s: &SurfaceReport) -> String {
         format!("{} / {}", s.n_surface_vertices, s.n_surface_triangles),
     );
     row("time surface (s)", format!("{:.3}", s.seconds_surface));
+    if let Some(r) = &s.repair {
+        row(
+            "repair: duplicates / flipped",
+            format!(
+                "{} vertices / {} triangles",
+                r.duplicate_vertices, r.flipped_triangles
+            ),
+        );
+        row(
+            "repair: open / non-manifold",
+            format!("{} / {} edges", r.open_edges, r.non_manifold_edges),
+        );
+        row(
+            "repair: intersecting pairs",
+            format!("{} ({} components)", r.intersecting_pairs, r.components),
+        );
+        row(
+            "repair: holes / hidden",
+            format!("{} spanned / {} triangles", r.holes, r.hidden_triangles),
+        );
+        row(
+            "repair: spanned area",
+            format!("{:.4e} of {:.4e}", r.spanned_area, r.boundary_area),
+        );
+    }
     out
 }
 
