@@ -56,16 +56,18 @@ pub fn surface_report(r: &Remeshed, mesh: &TetMesh) -> SurfaceReport {
         })
         .sum();
     let mut out_samples = hausdorff_samples(&out);
-    let repair = r.repaired.as_ref().map(|repaired| {
+    if let Some(repaired) = &r.repaired {
         // Where the boundary spans a hole no input is near: those samples measure nothing.
         out_samples.retain(|&p| {
             r.oracle.distance_beyond(p, r.distance).is_none() || !repaired.labels.spans_at(p)
         });
+    }
+    let repair = r.repair_counts.as_ref().map(|counts| {
         let (boundary_area, spanned_area) = spanned_area(&out, &r.oracle, r.distance);
         crate::surface::repair::Defects {
             boundary_area,
             spanned_area,
-            ..repaired.defects.clone()
+            ..counts.clone()
         }
     });
     SurfaceReport {

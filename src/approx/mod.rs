@@ -29,7 +29,7 @@ use crate::refine::{
 };
 use crate::surface::features::{FeatureParams, Features};
 use crate::surface::oracle::SurfaceOracle;
-use crate::surface::repair::Repaired;
+use crate::surface::repair::{Defects, Repaired};
 use crate::surface::thickness::Thickness;
 use crate::surface::InputSurface;
 use curves::FeatureCurves;
@@ -85,8 +85,11 @@ pub struct Remeshed {
     pub region_attributes: Vec<i32>,
     /// The input's region volumes and interface area (`Plc::input_regions`).
     pub input_regions: crate::plc::InputRegions,
-    /// A repaired input's solid (`--repair`).
+    /// A repaired input's solid (`--repair` on a dirty input).
     pub repaired: Option<Box<Repaired>>,
+    /// With `--repair`, what was wrong with the input (nothing but merged vertices or flipped
+    /// triangles when it was clean).
+    pub repair_counts: Option<Defects>,
     pub n_corners: usize,
     /// Small corners: point and protecting radius (the influence the report counts in).
     pub small_corners: Vec<(glam::DVec3, f64)>,
@@ -326,8 +329,8 @@ pub fn remesh(
         &surface,
         &FeatureParams {
             feature_angle: params.feature_angle,
-            use_markers: !params.repair && has_labels(input),
-            borders: !params.repair,
+            use_markers: source.repaired().is_none() && has_labels(input),
+            borders: source.repaired().is_none(),
         },
         &mut |p| f.at(p),
     );
@@ -373,14 +376,21 @@ pub fn remesh(
         .input_samples
         .take()
         .unwrap_or_else(|| measure::hausdorff_samples(&surface));
+    let (input_volume, region_attributes, input_regions) = (
+        source.volume(),
+        source.region_attributes(),
+        source.input_regions(),
+    );
+    let (repaired, repair_counts) = source.into_repaired();
     let remeshed = Remeshed {
         input_samples,
         small_corner_vertices,
         vertex_slide,
-        input_volume: source.volume(),
-        region_attributes: source.region_attributes(),
-        input_regions: source.input_regions(),
-        repaired: source.into_repaired(),
+        input_volume,
+        region_attributes,
+        input_regions,
+        repaired,
+        repair_counts,
         n_corners: curves.corners.len(),
         curves,
         small_corners,
@@ -400,33 +410,40 @@ pub fn remesh(
 /// The input as the approximate mode reads it: a checked PLC, or with `--repair` a dirty
 /// surface's solid.
 enum Source {
-    Checked(crate::plc::Plc),
+    /// With `--repair`, what was counted of the clean input.
+    Checked(crate::plc::Plc, Option<Defects>),
     Repaired(Box<Repaired>),
 }
 
 impl Source {
+    /// A clean input is meshed as it is, `--repair` or not (its mesh does not change, and the
+    /// faces that several regions share stay interfaces).
     fn read(input: &PlcInput, params: &Params) -> Result<Source, MeshError> {
-        if params.repair {
-            return Repaired::new(input)
+        let repair_error = |e: String| MeshError::InvalidInput(format!("repair: {e}"));
+        match crate::plc::validate(input) {
+            Ok(plc) if params.repair => {
+                let counts = Defects::of_clean(input).map_err(repair_error)?;
+                Ok(Source::Checked(plc, Some(counts)))
+            }
+            Ok(plc) => Ok(Source::Checked(plc, None)),
+            Err(_) if params.repair => Repaired::new(input)
                 .map(|r| Source::Repaired(Box::new(r)))
-                .map_err(|e| MeshError::InvalidInput(format!("repair: {e}")));
+                .map_err(repair_error),
+            Err(e) => Err(MeshError::InvalidInput(with_repair_hint(e))),
         }
-        crate::plc::validate(input)
-            .map(Source::Checked)
-            .map_err(|e| MeshError::InvalidInput(with_repair_hint(e)))
     }
 
     /// The triangles the boundary approximates.
     fn surface(&self) -> InputSurface {
         match self {
-            Source::Checked(plc) => InputSurface::from_plc(plc),
+            Source::Checked(plc, _) => InputSurface::from_plc(plc),
             Source::Repaired(r) => r.surface.clone(),
         }
     }
 
     fn repaired(&self) -> Option<&Repaired> {
         match self {
-            Source::Checked(_) => None,
+            Source::Checked(..) => None,
             Source::Repaired(r) => Some(r),
         }
     }
@@ -435,7 +452,7 @@ impl Source {
     /// relative difference).
     fn volume(&self) -> f64 {
         match self {
-            Source::Checked(plc) => plc.volume(),
+            Source::Checked(plc, _) => plc.volume(),
             Source::Repaired(_) => 0.0,
         }
     }
@@ -443,14 +460,14 @@ impl Source {
     /// Per region, its output attribute (a repaired input's solid is one region, 0).
     fn region_attributes(&self) -> Vec<i32> {
         match self {
-            Source::Checked(plc) => plc.region_attributes(),
+            Source::Checked(plc, _) => plc.region_attributes(),
             Source::Repaired(_) => vec![0],
         }
     }
 
     fn input_regions(&self) -> crate::plc::InputRegions {
         match self {
-            Source::Checked(plc) => plc.input_regions(),
+            Source::Checked(plc, _) => plc.input_regions(),
             Source::Repaired(_) => crate::plc::InputRegions {
                 volumes: vec![(0, 0.0)],
                 interface_area: 0.0,
@@ -458,10 +475,14 @@ impl Source {
         }
     }
 
-    fn into_repaired(self) -> Option<Box<Repaired>> {
+    /// The repaired solid, and what `--repair` counted of the input.
+    fn into_repaired(self) -> (Option<Box<Repaired>>, Option<Defects>) {
         match self {
-            Source::Checked(_) => None,
-            Source::Repaired(r) => Some(r),
+            Source::Checked(_, counts) => (None, counts),
+            Source::Repaired(r) => {
+                let counts = r.defects.clone();
+                (Some(r), Some(counts))
+            }
         }
     }
 }

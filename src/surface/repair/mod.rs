@@ -92,7 +92,17 @@ pub struct Repaired {
 const SIDE_OFFSET: f64 = 1e-7;
 
 impl Repaired {
+    /// The solid of a dirty `input`. Several regions (region seeds: solids of a multi-solid
+    /// STL, closed OBJ groups) are refused: each would need its own winding number, and the
+    /// faces two of them share are written once.
     pub fn new(input: &PlcInput) -> Result<Repaired, String> {
+        if input.regions.len() > 1 {
+            return Err(format!(
+                "the input has {} regions (solids or materials); repair meshes one solid, so \
+                 a dirty input with several is not handled yet",
+                input.regions.len()
+            ));
+        }
         let s = soup::Soup::of(input)?;
         let mut triangles = s.triangles;
         let flipped_triangles = orient::orient_consistently(&mut triangles);
@@ -207,6 +217,25 @@ impl Repaired {
     /// labels just in front and just behind differ.
     pub fn bounds_solid_at(&self, p: DVec3, normal: DVec3) -> bool {
         bounds_at(&self.labels, p, normal * self.side_offset)
+    }
+}
+
+impl Defects {
+    /// The counts a clean input (one that passed validation) gets with `--repair`: merged
+    /// vertices, flipped triangles, components; nothing intersects, nothing is open.
+    pub fn of_clean(input: &PlcInput) -> Result<Defects, String> {
+        let s = soup::Soup::of(input)?;
+        let mut triangles = s.triangles;
+        let flipped_triangles = orient::orient_consistently(&mut triangles);
+        let uses = orient::edge_uses(&triangles);
+        Ok(Defects {
+            triangles: triangles.len(),
+            duplicate_vertices: s.welded_vertices,
+            degenerate_triangles: s.degenerate_triangles,
+            flipped_triangles,
+            components: orient::components(triangles.len(), &uses),
+            ..Defects::default()
+        })
     }
 }
 
