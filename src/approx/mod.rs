@@ -411,7 +411,7 @@ pub fn remesh(
 /// surface's solid.
 enum Source {
     /// With `--repair`, what was counted of the clean input.
-    Checked(crate::plc::Plc, Option<Defects>),
+    Checked(Box<crate::plc::Plc>, Option<Defects>),
     Repaired(Box<Repaired>),
 }
 
@@ -423,9 +423,9 @@ impl Source {
         match crate::plc::validate(input) {
             Ok(plc) if params.repair => {
                 let counts = Defects::of_clean(input).map_err(repair_error)?;
-                Ok(Source::Checked(plc, Some(counts)))
+                Ok(Source::Checked(Box::new(plc), Some(counts)))
             }
-            Ok(plc) => Ok(Source::Checked(plc, None)),
+            Ok(plc) => Ok(Source::Checked(Box::new(plc), None)),
             Err(_) if params.repair => Repaired::new(input)
                 .map(|r| Source::Repaired(Box::new(r)))
                 .map_err(repair_error),
