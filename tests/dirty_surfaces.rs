@@ -290,7 +290,7 @@ fn check_repair(d: &Dirty) {
         / stats["surface"]["surface_distance"]
             .as_f64()
             .unwrap_or(f64::NAN);
-    if !(out_in <= OUT_IN_BOUNDS) {
+    if out_in.is_nan() || out_in > OUT_IN_BOUNDS {
         failures.push(format!(
             "output -> input distance {out_in:.3} bounds > {OUT_IN_BOUNDS} (spans left out)"
         ));
