@@ -426,8 +426,9 @@ per_case!(
     crack_sphere,
     crack_bear,
     fold_slab;
-    // Two homers 1% apart: the union's slivers along the fingers and ears make the cell
-    // level's boundary extraction diverge (non-manifold faces grow with each mend).
+    // Two homers 1% apart: where the copies' feet meet the union's boundary has a
+    // near-tangential contact (two sheets across a gap far below the distance bound), and the
+    // cell level's boundary extraction finds non-manifold edges there after every mend.
     open: overlap_homer,
 );
 
