@@ -82,6 +82,27 @@ impl Surface {
         self.triangles[t].map(|v| self.vertices[v as usize])
     }
 
+    /// The triangles `keep` accepts, without the vertices no kept triangle uses (renumbered
+    /// in order of first use).
+    pub fn keep_triangles(&self, keep: impl Fn(usize) -> bool) -> Surface {
+        let mut id = vec![u32::MAX; self.vertices.len()];
+        let mut out = Surface::default();
+        for (k, t) in self.triangles.iter().enumerate() {
+            if !keep(k) {
+                continue;
+            }
+            let t = t.map(|v| {
+                if id[v as usize] == u32::MAX {
+                    id[v as usize] = out.vertices.len() as u32;
+                    out.vertices.push(self.vertices[v as usize]);
+                }
+                id[v as usize]
+            });
+            out.triangles.push(t);
+        }
+        out
+    }
+
     /// Checks that the surface is a closed, consistently oriented 2-manifold: every directed
     /// edge is used once and its reverse once, no triangle is degenerate, no two vertices share
     /// a position (an STL reader identifies vertices by position), every vertex is used.
@@ -597,19 +618,7 @@ pub fn half_balls() -> Shape {
 
 /// `s` without the vertices no triangle uses, renumbered in order.
 fn compact(s: Surface) -> Surface {
-    let mut id = vec![u32::MAX; s.vertices.len()];
-    let mut out = Surface::default();
-    for t in &s.triangles {
-        let t = t.map(|v| {
-            if id[v as usize] == u32::MAX {
-                id[v as usize] = out.vertices.len() as u32;
-                out.vertices.push(s.vertices[v as usize]);
-            }
-            id[v as usize]
-        });
-        out.triangles.push(t);
-    }
-    out
+    s.keep_triangles(|_| true)
 }
 
 /// Two unit cubes sharing the face x = 1, as two STL solids: the common face appears in both,

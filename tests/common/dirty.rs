@@ -862,25 +862,9 @@ fn triangle_area(s: &Surface, t: usize) -> f64 {
     (b - a).cross(c - a).length() / 2.0
 }
 
-/// `s` restricted to the triangles `keep` accepts, without the vertices no kept triangle uses
-/// (renumbered in order of first use).
+/// `s` restricted to the triangles `keep` accepts (`Surface::keep_triangles`).
 fn keep_triangles(s: &Surface, keep: impl Fn(usize) -> bool) -> Surface {
-    let mut id = vec![u32::MAX; s.vertices.len()];
-    let mut out = Surface::default();
-    for (k, t) in s.triangles.iter().enumerate() {
-        if !keep(k) {
-            continue;
-        }
-        let t = t.map(|v| {
-            if id[v as usize] == u32::MAX {
-                id[v as usize] = out.vertices.len() as u32;
-                out.vertices.push(s.vertices[v as usize]);
-            }
-            id[v as usize]
-        });
-        out.triangles.push(t);
-    }
-    out
+    s.keep_triangles(keep)
 }
 
 /// For each triangle, the triangles sharing an edge with it.
