@@ -14,8 +14,8 @@
 !>  - Outputs are copied into arrays you allocate after asking for the count (sm_num_*).
 !>  - Callbacks are bind(C) procedures passed with c_funloc(); user data with c_loc() or
 !>    c_null_ptr. See examples/fortran/cube.f90.
-!>  - Functions taking a string (sm_set_param, sm_get_param, sm_write) have Fortran wrappers
-!>    that add the terminating NUL; the raw bind(C) ones are *_c.
+!>  - Functions taking a string (sm_set_param, sm_get_param, sm_write, sm_write_binary) have
+!>    Fortran wrappers that add the terminating NUL; the raw bind(C) ones are *_c.
 module slivermesh
   use, intrinsic :: iso_c_binding, only: c_ptr, c_funptr, c_null_ptr, c_null_char, c_char, &
                                          c_double, c_int32_t, c_size_t, c_associated, c_f_pointer
@@ -271,6 +271,13 @@ module slivermesh
       integer(c_int32_t) :: s
     end function sm_write_c
 
+    function sm_write_binary_c(m, path) bind(C, name="sm_write_binary") result(s)
+      import :: c_ptr, c_char, c_int32_t
+      type(c_ptr), value :: m
+      character(kind=c_char), intent(in) :: path(*)
+      integer(c_int32_t) :: s
+    end function sm_write_binary_c
+
     function sm_last_error_c(m) bind(C, name="sm_last_error") result(p)
       import :: c_ptr
       type(c_ptr), value :: m
@@ -306,10 +313,10 @@ module slivermesh
             sm_set_spacing_const, sm_set_param_c, sm_get_param_c, sm_set_progress_cb, &
             sm_refine, sm_num_vertices, sm_num_tets, sm_num_boundary_faces, sm_get_vertices, &
             sm_get_tets, sm_get_boundary_faces, sm_get_quality, sm_num_regions, sm_get_regions, &
-            sm_write_c, sm_last_error_c, &
+            sm_write_c, sm_write_binary_c, sm_last_error_c, &
             sm_stop_reason_c, sm_status_str_c, sm_version_c
-  public :: sm_set_param, sm_get_param, sm_write, sm_last_error, sm_stop_reason, &
-            sm_status_str, sm_version
+  public :: sm_set_param, sm_get_param, sm_write, sm_write_binary, sm_last_error, &
+            sm_stop_reason, sm_status_str, sm_version
 
 contains
 
@@ -364,6 +371,15 @@ contains
     integer(c_int32_t) :: s
     s = sm_write_c(m, c_string(path))
   end function sm_write
+
+  !> sm_write_binary with a Fortran string path (.msh: gmsh 4.1 binary, .vtu: binary appended
+  !> arrays; other formats as sm_write).
+  function sm_write_binary(m, path) result(s)
+    type(c_ptr), intent(in) :: m
+    character(len=*), intent(in) :: path
+    integer(c_int32_t) :: s
+    s = sm_write_binary_c(m, c_string(path))
+  end function sm_write_binary
 
   !> The message of the last fallible call on m ("" after a success).
   function sm_last_error(m) result(msg)

@@ -496,6 +496,16 @@ sm_status sm_get_boundary_faces(const sm_mesher *m,
 sm_status sm_write(const sm_mesher *m, const char *path);
 
 /**
+ * `sm_write`, in the format's binary form where it has one: .msh as gmsh 4.1 binary, .vtu with
+ * binary appended arrays (raw little-endian, UInt64 header); the other formats as `sm_write`
+ * writes them.
+ *
+ * # Safety
+ * `m` is NULL or a live handle; `path` is NULL or a NUL-terminated string.
+ */
+sm_status sm_write_binary(const sm_mesher *m, const char *path);
+
+/**
  * Why the last `sm_refine` stopped before every bound held (e.g. the vertex budget), or NULL
  * when it completed, has not run, or the handle is NULL. Owned by the handle, valid until the
  * next `sm_refine` or `sm_destroy`.

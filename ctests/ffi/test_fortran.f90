@@ -78,6 +78,7 @@ program test_fortran
   call expect(sm_get_tets(m, tets, capacity=1_c_size_t) == SM_ERR_NOT_REFINED, 'tets')
   call expect(sm_num_tets(m) == 0, 'num_tets')
   call expect(sm_write(m, 'never.vtu') == SM_ERR_NOT_REFINED, 'write before refine')
+  call expect(sm_write_binary(m, 'never.msh') == SM_ERR_NOT_REFINED, 'binary write before refine')
 
   call expect(sm_set_spacing_cb(m, c_funloc(zero_spacing), c_null_ptr) == SM_OK, 'spacing cb')
   call expect(sm_refine(m) == SM_ERR_SPACING, 'zero spacing fails')

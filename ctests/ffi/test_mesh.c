@@ -146,6 +146,18 @@ static void test_cube(void) {
         CHECK(got > 0 && strstr(head, "VTKFile") != NULL);
         fclose(f);
     }
+    /* The binary form of .msh (gmsh 4.1, file-type flag 1). */
+    remove("ctest_cube_binary.msh");
+    CHECK_STATUS(m, sm_write_binary(m, "ctest_cube_binary.msh"), SM_OK);
+    f = fopen("ctest_cube_binary.msh", "rb");
+    CHECK(f != NULL);
+    if (f) {
+        char head[64] = {0};
+        size_t got = fread(head, 1, sizeof head - 1, f);
+        CHECK(got > 20 && strncmp(head, "$MeshFormat\n4.1 1 8\n", 20) == 0);
+        fclose(f);
+    }
+    CHECK_STATUS(m, sm_write_binary(m, NULL), SM_ERR_NULL);
     CHECK_STATUS(m, sm_write(m, "no/such/dir/cube.vtu"), SM_ERR_IO);
     CHECK_ERROR_HAS(m, "no/such/dir/cube.vtu");
     CHECK_STATUS(m, sm_write(m, "cube.unknown_extension"), SM_ERR_IO);

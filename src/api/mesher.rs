@@ -369,7 +369,16 @@ impl Mesher {
 
     /// Writes the mesh (format by extension) with per-tet quality as cell data.
     pub fn write(&self, path: &Path) -> Result<(), Error> {
-        self.output.as_ref().ok_or(Error::NotRefined)?.write(path)
+        self.write_in(path, false)
+    }
+
+    /// [`Self::write`], in the format's binary form where it has one and `binary` is set
+    /// (.msh: gmsh 4.1 binary; .vtu: binary appended arrays).
+    pub fn write_in(&self, path: &Path, binary: bool) -> Result<(), Error> {
+        self.output
+            .as_ref()
+            .ok_or(Error::NotRefined)?
+            .write_in(path, binary)
     }
 
     /// Installs a result without meshing (tests of the output paths).

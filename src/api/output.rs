@@ -2,7 +2,7 @@
 
 use super::error::Error;
 use crate::geom::TetQuality;
-use crate::io::{write_mesh, CellField};
+use crate::io::CellField;
 use crate::mesh::TetMesh;
 use crate::refine::Report;
 use std::path::Path;
@@ -86,8 +86,14 @@ impl MeshOutput {
     /// Writes the mesh (format by extension: .vtu, .mesh, .msh, .node) with the per-tet quality
     /// measures as cell data where the format has room for them.
     pub fn write(&self, path: &Path) -> Result<(), Error> {
+        self.write_in(path, false)
+    }
+
+    /// [`Self::write`], in the format's binary form where it has one and `binary` is set
+    /// (.msh: gmsh 4.1 binary; .vtu: binary appended arrays).
+    pub fn write_in(&self, path: &Path, binary: bool) -> Result<(), Error> {
         let q = QualityFields::of(&self.mesh);
-        write_mesh(path, &self.mesh, &q.cell_fields())?;
+        crate::io::write_mesh_in(path, &self.mesh, &q.cell_fields(), binary)?;
         Ok(())
     }
 }

@@ -24,11 +24,6 @@ pub struct MeshOptions {
     /// from the input's local feature size.
     #[arg(long, value_name = "H")]
     pub size: Option<f64>,
-    /// Spacing interpolated from a size field on a background mesh: MEDIT/MMG .sol (with the
-    /// .mesh of the same stem beside it) or TetGen .mtr (with its .node/.ele); outside the
-    /// background, the nearest tet's value. Conflicts with --size.
-    #[arg(long, value_name = "FILE", conflicts_with = "size")]
-    pub size_field: Option<std::path::PathBuf>,
     /// Radius-edge bound rho0 (default 2).
     #[arg(long, value_name = "R")]
     pub rho: Option<f64>,
@@ -173,19 +168,8 @@ pub fn run_mesh(
              (this run keeps the input facets)"
         );
     }
-    if opts.size.is_some() && opts.size_field.is_some() {
-        return Err("--size and --size-field cannot be used together".to_string());
-    }
     let constant = opts.size.map(ConstantSpacing);
-    let field = match &opts.size_field {
-        Some(p) => Some(io::sizefield::read_size_field(p)?),
-        None => None,
-    };
-    let spacing = match (&constant, &field) {
-        (Some(c), _) => Some(c as &dyn Spacing),
-        (None, Some(f)) => Some(f as &dyn Spacing),
-        (None, None) => None,
-    };
+    let spacing = constant.as_ref().map(|s| s as &dyn Spacing);
     let is_mesh = input
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("mesh"));
@@ -354,18 +338,12 @@ pub fn write_with_quality(
     per_tet: Option<&[TetQuality]>,
     binary: bool,
 ) -> Result<(), String> {
-    let msh = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("msh"));
-    if binary && msh {
-        return io::gmsh_binary::write_msh_binary(path, mesh).map_err(|e| e.to_string());
-    }
     // Only .vtu has a place for cell data: measuring every tet for another format is wasted.
     if !path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("vtu"))
     {
-        return io::write_mesh(path, mesh, &[]).map_err(|e| e.to_string());
+        return io::write_mesh_in(path, mesh, &[], binary).map_err(|e| e.to_string());
     }
     let measured;
     let per_tet = match per_tet {
@@ -376,11 +354,7 @@ pub fn write_with_quality(
         }
     };
     let fields = slivermesh::api::QualityFields::from_measures(per_tet);
-    let fields = fields.cell_fields();
-    if binary {
-        return io::vtu_binary::write_vtu_binary(path, mesh, &fields).map_err(|e| e.to_string());
-    }
-    io::write_mesh(path, mesh, &fields).map_err(|e| e.to_string())
+    io::write_mesh_in(path, mesh, &fields.cell_fields(), binary).map_err(|e| e.to_string())
 }
 
 /// The built-in model: a 2 x 1 x 1 box of two materials (x < 1: region 1, x > 1: region 2)

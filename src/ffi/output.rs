@@ -174,6 +174,24 @@ pub unsafe extern "C" fn sm_write(m: *const sm_mesher, path: *const c_char) -> s
     })
 }
 
+/// `sm_write`, in the format's binary form where it has one: .msh as gmsh 4.1 binary, .vtu with
+/// binary appended arrays (raw little-endian, UInt64 header); the other formats as `sm_write`
+/// writes them.
+///
+/// # Safety
+/// `m` is NULL or a live handle; `path` is NULL or a NUL-terminated string.
+#[no_mangle]
+pub unsafe extern "C" fn sm_write_binary(m: *const sm_mesher, path: *const c_char) -> sm_status {
+    // SAFETY: `m` is NULL or a live handle (contract above).
+    let handle = unsafe { m.as_ref() };
+    handle_call(handle, "sm_write_binary", |st| {
+        // SAFETY: `path` is NULL or NUL-terminated (contract above).
+        let path = path_of(unsafe { c_str("path", path) }?)?;
+        st.mesher.write_in(&path, true)?;
+        Ok(())
+    })
+}
+
 /// A C path as a `PathBuf`: any bytes on Unix, UTF-8 elsewhere.
 fn path_of(s: &std::ffi::CStr) -> Result<PathBuf, FfiError> {
     #[cfg(unix)]

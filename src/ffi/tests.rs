@@ -568,6 +568,28 @@ fn cube_through_the_c_abi() {
             })
             .sum();
         assert!((volume - 1.0).abs() < 1e-9, "{volume}");
+        // The binary forms: a gmsh 4.1 binary .msh and a .vtu of appended raw arrays.
+        let dir = std::env::temp_dir().join(format!("sm-ffi-binary-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        for (name, marker) in [
+            ("cube.msh", &b"$MeshFormat\n4.1 1 8\n"[..]),
+            ("cube.vtu", &b"<AppendedData encoding=\"raw\">"[..]),
+        ] {
+            let path = dir.join(name);
+            let c_path = std::ffi::CString::new(path.to_str().unwrap()).unwrap();
+            assert_eq!(
+                sm_write_binary(h.0, c_path.as_ptr()),
+                SM_OK,
+                "{}",
+                last_error(&h)
+            );
+            let bytes = std::fs::read(&path).unwrap();
+            assert!(
+                bytes.windows(marker.len()).any(|w| w == marker),
+                "{name} is not in its binary form"
+            );
+        }
+        std::fs::remove_dir_all(&dir).ok();
     }
 }
 

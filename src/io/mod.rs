@@ -35,7 +35,6 @@ pub mod off;
 pub mod ply;
 pub mod points;
 pub mod poly;
-pub mod sizefield;
 mod solids;
 pub mod stl;
 pub mod tetgen;
@@ -154,6 +153,21 @@ pub fn write_mesh(path: &Path, mesh: &TetMesh, cell_fields: &[CellField]) -> Res
         "msh" => gmsh::write_msh(path, mesh),
         "inp" => abaqus::write_inp(path, mesh),
         _ => tetgen::write_tetgen(path, mesh),
+    }
+}
+
+/// [`write_mesh`], or where the format has a binary form (.msh: gmsh 4.1 binary, .vtu: binary
+/// appended arrays) and `binary` is set, that form.
+pub fn write_mesh_in(
+    path: &Path,
+    mesh: &TetMesh,
+    cell_fields: &[CellField],
+    binary: bool,
+) -> Result<(), IoError> {
+    match extension(path, WRITE_EXTENSIONS, "mesh")?.as_str() {
+        "vtu" if binary => vtu_binary::write_vtu_binary(path, mesh, cell_fields),
+        "msh" if binary => gmsh_binary::write_msh_binary(path, mesh),
+        _ => write_mesh(path, mesh, cell_fields),
     }
 }
 
