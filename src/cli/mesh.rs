@@ -24,6 +24,11 @@ pub struct MeshOptions {
     /// from the input's local feature size.
     #[arg(long, value_name = "H")]
     pub size: Option<f64>,
+    /// Spacing interpolated from a size field on a background mesh: MEDIT/MMG .sol (with the
+    /// .mesh of the same stem beside it) or TetGen .mtr (with its .node/.ele); outside the
+    /// background, the nearest tet's value. Conflicts with --size.
+    #[arg(long, value_name = "FILE", conflicts_with = "size")]
+    pub size_field: Option<std::path::PathBuf>,
     /// Radius-edge bound rho0 (default 2).
     #[arg(long, value_name = "R")]
     pub rho: Option<f64>,
@@ -168,8 +173,19 @@ pub fn run_mesh(
              (this run keeps the input facets)"
         );
     }
+    if opts.size.is_some() && opts.size_field.is_some() {
+        return Err("--size and --size-field cannot be used together".to_string());
+    }
     let constant = opts.size.map(ConstantSpacing);
-    let spacing = constant.as_ref().map(|s| s as &dyn Spacing);
+    let field = match &opts.size_field {
+        Some(p) => Some(io::sizefield::read_size_field(p)?),
+        None => None,
+    };
+    let spacing = match (&constant, &field) {
+        (Some(c), _) => Some(c as &dyn Spacing),
+        (None, Some(f)) => Some(f as &dyn Spacing),
+        (None, None) => None,
+    };
     let is_mesh = input
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("mesh"));

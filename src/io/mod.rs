@@ -35,6 +35,7 @@ pub mod off;
 pub mod ply;
 pub mod points;
 pub mod poly;
+pub mod sizefield;
 mod solids;
 pub mod stl;
 pub mod tetgen;

@@ -2,6 +2,7 @@
 //! boundary recovery (empty encroachment), domain marking, then cleaning of size-bad,
 //! radius-edge-bad and sliver tets from random points of picking regions.
 
+pub mod background;
 #[cfg(test)]
 mod check;
 mod domain;
