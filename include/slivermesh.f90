@@ -160,6 +160,20 @@ module slivermesh
       integer(c_int32_t) :: s
     end function sm_set_spacing_const
 
+    !> Spacing from a size field on a background tet mesh: xyz(3 * n_vertices), tets(4 * n_tets)
+    !> (0-based vertex ids), values(n_vertices) > 0; linear in the tets, nearest point outside.
+    function sm_set_spacing_mesh(m, xyz, n_vertices, tets, n_tets, values) &
+        bind(C, name="sm_set_spacing_mesh") result(s)
+      import :: c_ptr, c_double, c_size_t, c_int32_t
+      type(c_ptr), value :: m
+      real(c_double), intent(in) :: xyz(*)
+      integer(c_size_t), value :: n_vertices
+      integer(c_int32_t), intent(in) :: tets(*)
+      integer(c_size_t), value :: n_tets
+      real(c_double), intent(in) :: values(*)
+      integer(c_int32_t) :: s
+    end function sm_set_spacing_mesh
+
     function sm_set_param_c(m, name, value) bind(C, name="sm_set_param") result(s)
       import :: c_ptr, c_char, c_double, c_int32_t
       type(c_ptr), value :: m
@@ -310,7 +324,7 @@ module slivermesh
 
   public :: sm_create, sm_destroy, sm_add_vertices, sm_add_facet, sm_add_facet_hole, &
             sm_add_hole, sm_add_region, sm_set_spacing_cb, sm_set_spacing_batch_cb, &
-            sm_set_spacing_const, sm_set_param_c, sm_get_param_c, sm_set_progress_cb, &
+            sm_set_spacing_const, sm_set_spacing_mesh, sm_set_param_c, sm_get_param_c, sm_set_progress_cb, &
             sm_refine, sm_num_vertices, sm_num_tets, sm_num_boundary_faces, sm_get_vertices, &
             sm_get_tets, sm_get_boundary_faces, sm_get_quality, sm_num_regions, sm_get_regions, &
             sm_write_c, sm_write_binary_c, sm_last_error_c, &

@@ -393,6 +393,26 @@ sm_status sm_set_spacing_cb(sm_mesher *m, sm_spacing_fn f, void *user_data);
 sm_status sm_set_spacing_batch_cb(sm_mesher *m, sm_spacing_batch_fn f, void *user_data);
 
 /**
+ * Uses a size field on a background tet mesh as the spacing (adaptive loops: the field computed
+ * on the previous mesh): `n_vertices` points `xyz` (3 doubles each), `n_tets` tets `tets` (4
+ * 0-based vertex ids each) and one value per vertex (finite, > 0). The spacing at a point is the
+ * linear interpolation of the values in the background tet holding it; outside every tet, the
+ * value at the nearest point of the background. The arrays are copied. Replaces any other
+ * spacing. `SM_ERR_INVALID_ARGUMENT` names a bad vertex, value or tet.
+ *
+ * # Safety
+ * `m` is NULL or a live handle; `xyz` points to `3 * n_vertices` doubles, `tets` to
+ * `4 * n_tets` ids and `values` to `n_vertices` doubles (each may be NULL only when its count
+ * is 0).
+ */
+sm_status sm_set_spacing_mesh(sm_mesher *m,
+                              const double *xyz,
+                              size_t n_vertices,
+                              const uint32_t *tets,
+                              size_t n_tets,
+                              const double *values);
+
+/**
  * Calls `f(fraction, n_vertices, user_data)` during `sm_refine` (once with 0 before any work);
  * a non-zero return cancels it with `SM_ERR_CANCELLED`. `f` == NULL removes the callback.
  *

@@ -190,6 +190,49 @@ static void test_boundary_only(void) {
     sm_destroy(m);
 }
 
+/* A size field on a background mesh of the cube (six tets around its diagonal), 0.05 at x = 0
+ * to 0.3 at x = 1: the tets near x = 0 come out smaller. A zero value is refused. */
+static void test_size_field(void) {
+    static const uint32_t BG_TETS[24] = {0, 1, 3, 7, 0, 3, 2, 7, 0, 2, 6, 7,
+                                         0, 6, 4, 7, 0, 4, 5, 7, 0, 5, 1, 7};
+    double values[8], near = 0, far = 0;
+    size_t i, nv, nt, n_near = 0, n_far = 0;
+    double *xyz;
+    uint32_t *tets;
+    sm_mesher *m = make_cube();
+    for (i = 0; i < 8; i++) values[i] = 0.05 + 0.25 * CUBE_XYZ[3 * i];
+    values[3] = 0;
+    CHECK_STATUS(m, sm_set_spacing_mesh(m, CUBE_XYZ, 8, BG_TETS, 6, values),
+                 SM_ERR_INVALID_ARGUMENT);
+    values[3] = 0.05 + 0.25 * CUBE_XYZ[9];
+    CHECK_STATUS(m, sm_set_spacing_mesh(m, CUBE_XYZ, 8, BG_TETS, 6, values), SM_OK);
+    CHECK_STATUS(m, sm_refine(m), SM_OK);
+    nv = sm_num_vertices(m);
+    nt = sm_num_tets(m);
+    xyz = malloc(3 * nv * sizeof *xyz);
+    tets = malloc(4 * nt * sizeof *tets);
+    CHECK(xyz && tets);
+    if (xyz && tets) {
+        CHECK_STATUS(m, sm_get_vertices(m, xyz, nv), SM_OK);
+        CHECK_STATUS(m, sm_get_tets(m, tets, NULL, nt), SM_OK);
+        for (i = 0; i < nt; i++) {
+            const uint32_t *t = tets + 4 * i;
+            double cx = (xyz[3 * t[0]] + xyz[3 * t[1]] + xyz[3 * t[2]] + xyz[3 * t[3]]) / 4;
+            double v = cbrt(tet_volume(xyz, t));
+            if (cx < 0.2) { near += v; n_near++; }
+            if (cx > 0.8) { far += v; n_far++; }
+        }
+        CHECK(n_near > 0 && n_far > 0);
+        /* Cube roots of the mean tet volumes: about the ratio of the sizes. */
+        printf("size field: mean tet size near x = 0: %.4f, near x = 1: %.4f\n",
+               near / (double)n_near, far / (double)n_far);
+        CHECK(far / (double)n_far > 2 * near / (double)n_near);
+    }
+    free(xyz);
+    free(tets);
+    sm_destroy(m);
+}
+
 static void test_non_planar_facet(void) {
     sm_mesher *m = sm_create();
     /* The cube with its top corner 7 lifted: facets 1, 3 and 5 are no longer planar. */
@@ -258,6 +301,7 @@ static void test_cancel_mid_run(void) {
 int main(void) {
     test_cube();
     test_boundary_only();
+    test_size_field();
     test_non_planar_facet();
     test_bad_spacing_inside();
     test_cancel_mid_run();

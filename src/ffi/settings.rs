@@ -3,7 +3,7 @@
 use super::callbacks::{sm_progress_fn, sm_spacing_batch_fn, sm_spacing_fn, CProgress, CSpacing};
 use super::guard::handle_call;
 use super::mesher::sm_mesher;
-use super::slices::utf8;
+use super::slices::{input, scaled, utf8};
 use super::status::*;
 use std::ffi::{c_char, c_void};
 
@@ -132,6 +132,53 @@ pub unsafe extern "C" fn sm_set_spacing_batch_cb(
     handle_call(handle, "sm_set_spacing_batch_cb", |st| {
         st.mesher.set_spacing_automatic();
         st.spacing_cb = f.map(|f| CSpacing::batch(f, user_data));
+        Ok(())
+    })
+}
+
+/// Uses a size field on a background tet mesh as the spacing (adaptive loops: the field computed
+/// on the previous mesh): `n_vertices` points `xyz` (3 doubles each), `n_tets` tets `tets` (4
+/// 0-based vertex ids each) and one value per vertex (finite, > 0). The spacing at a point is the
+/// linear interpolation of the values in the background tet holding it; outside every tet, the
+/// value at the nearest point of the background. The arrays are copied. Replaces any other
+/// spacing. `SM_ERR_INVALID_ARGUMENT` names a bad vertex, value or tet.
+///
+/// # Safety
+/// `m` is NULL or a live handle; `xyz` points to `3 * n_vertices` doubles, `tets` to
+/// `4 * n_tets` ids and `values` to `n_vertices` doubles (each may be NULL only when its count
+/// is 0).
+#[no_mangle]
+pub unsafe extern "C" fn sm_set_spacing_mesh(
+    m: *mut sm_mesher,
+    xyz: *const f64,
+    n_vertices: usize,
+    tets: *const u32,
+    n_tets: usize,
+    values: *const f64,
+) -> sm_status {
+    // SAFETY: `m` is NULL or a live handle (contract above).
+    let handle = unsafe { m.as_ref() };
+    handle_call(handle, "sm_set_spacing_mesh", |st| {
+        let xyz_len = scaled("xyz", n_vertices, 3)?;
+        let tets_len = scaled("tets", n_tets, 4)?;
+        // SAFETY: the pointers hold the counts the contract above says.
+        let (xyz, tets, values) = unsafe {
+            (
+                input("xyz", xyz, xyz_len)?,
+                input("tets", tets, tets_len)?,
+                input("values", values, n_vertices)?,
+            )
+        };
+        let field = crate::refine::background::BackgroundSpacing::new(
+            xyz.chunks_exact(3).map(glam::DVec3::from_slice).collect(),
+            tets.chunks_exact(4)
+                .map(|t| [t[0], t[1], t[2], t[3]])
+                .collect(),
+            values.to_vec(),
+        )
+        .map_err(|e| FfiError::invalid(format!("size field: {e}")))?;
+        st.mesher.set_spacing(field);
+        st.spacing_cb = None;
         Ok(())
     })
 }

@@ -593,6 +593,57 @@ fn cube_through_the_c_abi() {
     }
 }
 
+/// A size field on a background mesh of the cube (six tets around its diagonal), varying 6x
+/// along x: the tets near x = 0 come out smaller than those near x = 1; a bad value is named.
+#[test]
+fn size_field_through_the_c_abi() {
+    let h = cube();
+    let corners: Vec<f64> = (0..8)
+        .flat_map(|i| [i & 1, (i >> 1) & 1, (i >> 2) & 1].map(f64::from))
+        .collect();
+    let tets: [u32; 24] = [
+        0, 1, 3, 7, 0, 3, 2, 7, 0, 2, 6, 7, 0, 6, 4, 7, 0, 4, 5, 7, 0, 5, 1, 7,
+    ];
+    let field = |x: f64| 0.05 + 0.25 * x;
+    let values: Vec<f64> = corners.chunks_exact(3).map(|p| field(p[0])).collect();
+    // SAFETY: live handle; the arrays hold the counts passed.
+    unsafe {
+        let mut bad = values.clone();
+        bad[5] = 0.0;
+        let s = sm_set_spacing_mesh(h.0, corners.as_ptr(), 8, tets.as_ptr(), 6, bad.as_ptr());
+        assert_eq!(s, SM_ERR_INVALID_ARGUMENT);
+        assert!(last_error(&h).contains('6'), "{}", last_error(&h));
+        let s = sm_set_spacing_mesh(h.0, corners.as_ptr(), 8, tets.as_ptr(), 6, values.as_ptr());
+        assert_eq!(s, SM_OK, "{}", last_error(&h));
+        assert_eq!(sm_refine(h.0), SM_OK, "{}", last_error(&h));
+        let (nv, nt) = (sm_num_vertices(h.0), sm_num_tets(h.0));
+        let mut xyz = vec![0.0; 3 * nv];
+        let mut t = vec![0u32; 4 * nt];
+        assert_eq!(sm_get_vertices(h.0, xyz.as_mut_ptr(), nv), SM_OK);
+        assert_eq!(sm_get_tets(h.0, t.as_mut_ptr(), null_mut(), nt), SM_OK);
+        let p = |i: u32| DVec3::from_slice(&xyz[3 * i as usize..]);
+        // Mean edge length of the tets whose centroid lies in each end slab.
+        let mean_edge = |lo: f64, hi: f64| {
+            let (mut sum, mut n) = (0.0, 0);
+            for tet in t.chunks_exact(4) {
+                let c = tet.iter().map(|&v| p(v)).sum::<DVec3>() / 4.0;
+                if c.x >= lo && c.x < hi {
+                    for (a, b) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
+                        sum += (p(tet[a]) - p(tet[b])).length();
+                        n += 1;
+                    }
+                }
+            }
+            sum / n as f64
+        };
+        let (near, far) = (mean_edge(0.0, 0.2), mean_edge(0.8, 1.0));
+        assert!(
+            far > 2.0 * near,
+            "edges near x = 0: {near}, near x = 1: {far}"
+        );
+    }
+}
+
 /// Two regions through the C ABI: the cube split by the facet x = 0.5 (two region seeds), each
 /// region's figures and the interface area from `sm_get_regions`.
 #[test]
