@@ -73,6 +73,11 @@ program test_fortran
   call expect(sm_set_param(m, 'rho00', 1.5d0) == SM_ERR_INVALID_ARGUMENT, 'unknown name')
   call expect(index(sm_last_error(m), 'valid names') > 0, 'unknown name message')
   call expect(sm_set_param(m, 'sigma0', 1d0) == SM_ERR_INVALID_ARGUMENT, 'sigma0 range')
+  ! A size field whose one tet names a vertex that is not there.
+  call expect(sm_set_spacing_mesh(m, [0d0, 0d0, 0d0, 1d0, 0d0, 0d0, 0d0, 1d0, 0d0, 0d0, 0d0, 1d0], &
+                                  4_c_size_t, [0, 1, 2, 4], 1_c_size_t, [0.1d0, 0.1d0, 0.1d0, 0.1d0]) &
+              == SM_ERR_INVALID_ARGUMENT, 'size field tet out of range')
+  call expect(index(sm_last_error(m), 'size field') > 0, 'size field message')
 
   call expect(sm_get_quality(m, q) == SM_ERR_NOT_REFINED, 'quality before refine')
   call expect(sm_get_tets(m, tets, capacity=1_c_size_t) == SM_ERR_NOT_REFINED, 'tets')
