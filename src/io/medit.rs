@@ -23,6 +23,26 @@ use std::io::Write;
 use std::path::Path;
 
 /// Writes `mesh` as a medit `.mesh` file.
+/// Reads and checks the value after a MEDIT header keyword (`lower`: "meshversionformatted",
+/// a version 1-3, or "dimension", 3), for .mesh and .sol files alike; true for the version.
+pub(super) fn read_header_value(tok: &mut Tokens, lower: &str) -> Result<bool, IoError> {
+    if lower == "dimension" {
+        let (l, w) = tok.next("dimension")?;
+        if w != "3" {
+            return Err(err_at(l, format!("dimension must be 3, found '{w}'")));
+        }
+        return Ok(false);
+    }
+    let (l, w) = tok.next("mesh version")?;
+    if !matches!(w, "1" | "2" | "3") {
+        return Err(err_at(
+            l,
+            format!("unsupported MeshVersionFormatted '{w}' (1, 2 or 3)"),
+        ));
+    }
+    Ok(true)
+}
+
 pub fn write_medit(path: &Path, mesh: &TetMesh) -> Result<(), IoError> {
     check_mesh(mesh, &[]).map_err(|e| with_path(e, path))?;
     let mut w = create(path)?;
@@ -101,21 +121,8 @@ pub fn parse_medit(text: &str) -> Result<TetMesh, IoError> {
     while let Some((line, kw)) = tok.next_opt() {
         let lower = kw.to_ascii_lowercase();
         match lower.as_str() {
-            "meshversionformatted" => {
-                let (l, w) = tok.next("mesh version")?;
-                if !matches!(w, "1" | "2" | "3") {
-                    return Err(err_at(
-                        l,
-                        format!("unsupported MeshVersionFormatted '{w}' (1, 2 or 3)"),
-                    ));
-                }
-                seen_version = true;
-            }
-            "dimension" => {
-                let (l, w) = tok.next("dimension")?;
-                if w != "3" {
-                    return Err(err_at(l, format!("dimension must be 3, found '{w}'")));
-                }
+            "meshversionformatted" | "dimension" => {
+                seen_version |= read_header_value(&mut tok, lower.as_str())?;
             }
             "vertices" => {
                 if seen_vertices {

@@ -80,22 +80,10 @@ pub fn parse_sol(text: &str) -> Result<Vec<f64>, IoError> {
     let mut seen_version = false;
     let mut values: Option<Vec<f64>> = None;
     while let Some((line, kw)) = tok.next_opt() {
-        match kw.to_ascii_lowercase().as_str() {
-            "meshversionformatted" => {
-                let (l, w) = tok.next("mesh version")?;
-                if !matches!(w, "1" | "2" | "3") {
-                    return Err(err_at(
-                        l,
-                        format!("unsupported MeshVersionFormatted '{w}' (1, 2 or 3)"),
-                    ));
-                }
-                seen_version = true;
-            }
-            "dimension" => {
-                let (l, w) = tok.next("dimension")?;
-                if w != "3" {
-                    return Err(err_at(l, format!("dimension must be 3, found '{w}'")));
-                }
+        let lower = kw.to_ascii_lowercase();
+        match lower.as_str() {
+            "meshversionformatted" | "dimension" => {
+                seen_version |= super::medit::read_header_value(&mut tok, lower.as_str())?;
             }
             "solatvertices" => {
                 if values.is_some() {
