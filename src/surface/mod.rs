@@ -18,6 +18,8 @@ pub mod features;
 pub mod oracle;
 pub mod repair;
 #[cfg(test)]
+mod test_shapes;
+#[cfg(test)]
 mod tests;
 pub mod thickness;
 pub mod winding;

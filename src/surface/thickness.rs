@@ -186,46 +186,7 @@ mod tests {
 
     /// An octahedron subdivided `levels` times and pushed onto the unit sphere, then scaled.
     fn ellipsoid(levels: u32, scale: DVec3) -> InputSurface {
-        let mut v = vec![
-            DVec3::X,
-            -DVec3::X,
-            DVec3::Y,
-            -DVec3::Y,
-            DVec3::Z,
-            -DVec3::Z,
-        ];
-        let mut t: Vec<[u32; 3]> = vec![
-            [0, 2, 4],
-            [2, 1, 4],
-            [1, 3, 4],
-            [3, 0, 4],
-            [2, 0, 5],
-            [1, 2, 5],
-            [3, 1, 5],
-            [0, 3, 5],
-        ];
-        for _ in 0..levels {
-            let mut mid = std::collections::HashMap::new();
-            let mut next = vec![];
-            for tri in &t {
-                let m: Vec<u32> = (0..3)
-                    .map(|j| {
-                        let (a, b) = (tri[j].min(tri[(j + 1) % 3]), tri[j].max(tri[(j + 1) % 3]));
-                        *mid.entry((a, b)).or_insert_with(|| {
-                            v.push(((v[a as usize] + v[b as usize]) / 2.0).normalize());
-                            (v.len() - 1) as u32
-                        })
-                    })
-                    .collect();
-                next.extend([
-                    [tri[0], m[0], m[2]],
-                    [m[0], tri[1], m[1]],
-                    [m[2], m[1], tri[2]],
-                    [m[0], m[1], m[2]],
-                ]);
-            }
-            t = next;
-        }
+        let (v, t) = crate::surface::test_shapes::octahedron_sphere(levels);
         InputSurface::from_triangles(v.iter().map(|p| *p * scale).collect(), t)
     }
 

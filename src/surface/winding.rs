@@ -197,42 +197,9 @@ mod tests {
         (v, t)
     }
 
-    /// A sphere of `subdivisions` levels (octahedron pushed out), outward.
+    /// A sphere of `levels` subdivisions (octahedron pushed out), outward.
     fn sphere(levels: u32) -> (Vec<DVec3>, Vec<[u32; 3]>) {
-        let mut v = vec![
-            DVec3::X,
-            -DVec3::X,
-            DVec3::Y,
-            -DVec3::Y,
-            DVec3::Z,
-            -DVec3::Z,
-        ];
-        let mut t: Vec<[u32; 3]> = vec![
-            [0, 2, 4],
-            [2, 1, 4],
-            [1, 3, 4],
-            [3, 0, 4],
-            [2, 0, 5],
-            [1, 2, 5],
-            [3, 1, 5],
-            [0, 3, 5],
-        ];
-        for _ in 0..levels {
-            let mut mid = std::collections::HashMap::new();
-            let mut next = vec![];
-            for [a, b, c] in t {
-                let mut m = |x: u32, y: u32| {
-                    *mid.entry((x.min(y), x.max(y))).or_insert_with(|| {
-                        v.push(((v[x as usize] + v[y as usize]) / 2.0).normalize());
-                        v.len() as u32 - 1
-                    })
-                };
-                let (ab, bc, ca) = (m(a, b), m(b, c), m(c, a));
-                next.extend([[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]);
-            }
-            t = next;
-        }
-        (v, t)
+        crate::surface::test_shapes::octahedron_sphere(levels)
     }
 
     #[test]

@@ -103,17 +103,7 @@ mod tests {
 
     /// The eight faces of an octahedron, outward.
     fn octahedron() -> Vec<[u32; 3]> {
-        // 0 +x, 1 -x, 2 +y, 3 -y, 4 +z, 5 -z
-        vec![
-            [0, 2, 4],
-            [2, 1, 4],
-            [1, 3, 4],
-            [3, 0, 4],
-            [2, 0, 5],
-            [1, 2, 5],
-            [3, 1, 5],
-            [0, 3, 5],
-        ]
+        crate::surface::test_shapes::octahedron_sphere(0).1
     }
 
     #[test]
