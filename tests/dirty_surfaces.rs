@@ -15,6 +15,7 @@ mod common;
 
 use common::corpus::{self, Surface, TriangleTree};
 use common::dirty::{self, Dirty, Kind};
+use common::{tail, ScratchDir};
 use slivermesh::geom::orient3d;
 use slivermesh::{DVec3, TetMesh};
 use std::collections::HashMap;
@@ -65,28 +66,9 @@ fn volume_tolerance(kind: Kind) -> f64 {
     }
 }
 
-/// A scratch directory removed when dropped, also when a check panics.
-struct ScratchDir(PathBuf);
-
-impl ScratchDir {
-    fn new(name: &str) -> ScratchDir {
-        let dir =
-            std::env::temp_dir().join(format!("slivermesh-dirty-{name}-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        ScratchDir(dir)
-    }
-}
-
-impl Drop for ScratchDir {
-    fn drop(&mut self) {
-        std::fs::remove_dir_all(&self.0).ok();
-    }
-}
-
-/// The last `n` lines of a text.
-fn tail(s: &str, n: usize) -> String {
-    let lines: Vec<&str> = s.lines().collect();
-    lines[lines.len().saturating_sub(n)..].join("\n")
+/// This file's scratch directories.
+fn scratch(name: &str) -> ScratchDir {
+    ScratchDir::new("dirty", name)
 }
 
 /// One CLI run: its exit code (None if killed or ended by a signal), output and wall time.
@@ -159,7 +141,7 @@ fn run_cli(d: &Dirty, dir: &Path, repair: bool, limit: Duration) -> Run {
 /// triangles are the exception: the approximate mode takes inside and outside from the
 /// surface's cells, not from the triangles' orientation, so it meshes them as they are.
 fn check_refusal(d: &Dirty) {
-    let dir = ScratchDir::new(&format!("refuse-{}", d.name));
+    let dir = scratch(&format!("refuse-{}", d.name));
     let run = run_cli(d, &dir.0, false, Duration::from_secs(120));
     let name = &d.name;
     assert!(
@@ -258,7 +240,7 @@ fn check_repair(d: &Dirty) {
         return;
     }
     let name = &d.name;
-    let dir = ScratchDir::new(&format!("repair-{name}"));
+    let dir = scratch(&format!("repair-{name}"));
     let run = {
         let _one = ONE_RUN_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
         run_cli(d, &dir.0, true, Duration::from_secs_f64(TIME_LIMIT + 5.0))
@@ -940,7 +922,7 @@ fn corpus_area_share_helper_measures_known_cases() {
 #[test]
 fn repair_in_keep_mode_is_refused() {
     let d = dirty::small_hole_sphere();
-    let dir = ScratchDir::new("repair-keep");
+    let dir = scratch("repair-keep");
     let input = dir.0.join(d.file_name());
     std::fs::write(&input, d.file_text()).unwrap();
     let mesh = dir.0.join("out.mesh");
@@ -960,7 +942,7 @@ fn repair_in_keep_mode_is_refused() {
 /// faces two solids share stay interfaces (two regions, not one solid).
 #[test]
 fn repair_leaves_clean_inputs_unchanged() {
-    let dir = ScratchDir::new("repair-clean");
+    let dir = scratch("repair-clean");
     let blocks = common::corpus::two_touching_blocks_stl();
     let stl = dir.0.join(blocks.file_name());
     std::fs::write(&stl, blocks.file_text()).unwrap();

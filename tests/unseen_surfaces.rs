@@ -11,6 +11,7 @@
 mod common;
 
 use common::corpus::{self, Shape, Surface};
+use common::{tail, ScratchDir};
 use slivermesh::geom::orient3d;
 use slivermesh::TetMesh;
 use std::collections::HashMap;
@@ -29,35 +30,20 @@ const INTERFACE_AREA_TOL: f64 = 2e-2;
 /// Default floor of the smallest dihedral angle (the approximate mode's improvement target).
 const MIN_DIHEDRAL: f64 = 20.0;
 
-/// A scratch directory removed when dropped, also when a check panics.
-struct ScratchDir(PathBuf);
-
-impl ScratchDir {
-    fn new(name: &str) -> ScratchDir {
-        let dir =
-            std::env::temp_dir().join(format!("slivermesh-unseen-{name}-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        ScratchDir(dir)
-    }
-}
-
-impl Drop for ScratchDir {
-    fn drop(&mut self) {
-        std::fs::remove_dir_all(&self.0).ok();
-    }
+/// This file's scratch directories.
+fn scratch(name: &str) -> ScratchDir {
+    ScratchDir::new("unseen", name)
 }
 
 /// The last `n` lines of a process's output.
-fn tail(bytes: &[u8], n: usize) -> String {
-    let s = String::from_utf8_lossy(bytes);
-    let lines: Vec<&str> = s.lines().collect();
-    lines[lines.len().saturating_sub(n)..].join("\n")
+fn tail_of(bytes: &[u8], n: usize) -> String {
+    tail(&String::from_utf8_lossy(bytes), n)
 }
 
 /// Runs `slivermesh mesh` on the shape's file at the defaults; returns the written mesh, the
 /// stats JSON and the wall time.
 fn run_cli(shape: &Shape) -> (TetMesh, serde_json::Value, f64) {
-    let dir = ScratchDir::new(shape.name);
+    let dir = scratch(shape.name);
     let input = dir.0.join(shape.file_name());
     let (output, json) = (
         dir.0.join(format!("{}.mesh", shape.name)),
@@ -80,8 +66,8 @@ fn run_cli(shape: &Shape) -> (TetMesh, serde_json::Value, f64) {
         "{}: slivermesh mesh exited with {} after {seconds:.1}s\nstderr:\n{}\nstdout (tail):\n{}",
         shape.name,
         run.status,
-        tail(&run.stderr, 20),
-        tail(&run.stdout, 20)
+        tail_of(&run.stderr, 20),
+        tail_of(&run.stdout, 20)
     );
     let mesh = slivermesh::io::read_mesh(&output)
         .unwrap_or_else(|e| panic!("{}: reading the written mesh: {e}", shape.name));
@@ -435,7 +421,7 @@ fn several_regions_in_keep_mode() {
         return;
     }
     for shape in corpus::multi_body() {
-        let dir = ScratchDir::new(&format!("keep-{}", shape.name));
+        let dir = scratch(&format!("keep-{}", shape.name));
         let path = dir.0.join(shape.file_name());
         std::fs::write(&path, shape.file_text()).unwrap();
         let input = slivermesh::io::read_plc(&path, &Default::default()).unwrap();
@@ -476,7 +462,7 @@ fn several_regions_are_deterministic() {
         return;
     }
     let shape = corpus::three_regions_edge();
-    let dir = ScratchDir::new("determinism");
+    let dir = scratch("determinism");
     let path = dir.0.join(shape.file_name());
     std::fs::write(&path, shape.file_text()).unwrap();
     let input = slivermesh::io::read_plc(&path, &Default::default()).unwrap();

@@ -236,3 +236,28 @@ pub fn enclosed_volume(input: &PlcInput) -> Option<f64> {
     }
     Some(six_v.abs() / 6.0)
 }
+
+/// A scratch directory under the system's temporary one, removed when dropped (also when a
+/// check panics): `slivermesh-{prefix}-{name}-{pid}`.
+pub struct ScratchDir(pub PathBuf);
+
+impl ScratchDir {
+    pub fn new(prefix: &str, name: &str) -> ScratchDir {
+        let dir =
+            std::env::temp_dir().join(format!("slivermesh-{prefix}-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        ScratchDir(dir)
+    }
+}
+
+impl Drop for ScratchDir {
+    fn drop(&mut self) {
+        std::fs::remove_dir_all(&self.0).ok();
+    }
+}
+
+/// The last `n` lines of a text.
+pub fn tail(s: &str, n: usize) -> String {
+    let lines: Vec<&str> = s.lines().collect();
+    lines[lines.len().saturating_sub(n)..].join("\n")
+}
