@@ -18,3 +18,72 @@ pub struct TetMesh {
     /// Input facet marker of each boundary triangle.
     pub boundary_markers: Vec<i32>,
 }
+
+/// The mid-edge nodes that make a [`TetMesh`] a mesh of ten-node (quadratic) tets.
+///
+/// Node ids continue after the corner vertices: mid-edge node `k` is node
+/// `mesh.vertices.len() + k`. Each edge has one node, shared by every tet and boundary
+/// triangle around it.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct QuadraticNodes {
+    /// Position of each mid-edge node (on the input surface for curved boundary edges).
+    pub points: Vec<DVec3>,
+    /// Per tet `[a, b, c, d]`, the node ids of its edges in the order
+    /// `ab, bc, ac, ad, bd, cd` (VTK's `VTK_QUADRATIC_TETRA` and Abaqus C3D10 order).
+    pub tet_edges: Vec<[u32; 6]>,
+    /// Per boundary triangle `[a, b, c]`, the node ids of its edges `ab, bc, ca`.
+    pub boundary_edges: Vec<[u32; 3]>,
+}
+
+/// The corner pairs of a tet's six edges, in [`QuadraticNodes::tet_edges`] order.
+pub const TET_EDGES: [(usize, usize); 6] = [(0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3)];
+
+/// The corner pairs of a triangle's three edges, in [`QuadraticNodes::boundary_edges`] order.
+pub const TRIANGLE_EDGES: [(usize, usize); 3] = [(0, 1), (1, 2), (2, 0)];
+
+impl QuadraticNodes {
+    /// One node at the midpoint of every edge of `mesh`'s tets and boundary triangles: the
+    /// straight-sided ten-node mesh. Nodes are numbered in the order their edges first appear
+    /// (tets first, in tet order), so the numbering depends only on the mesh.
+    pub fn straight(mesh: &TetMesh) -> QuadraticNodes {
+        let mut ids: rustc_hash::FxHashMap<(u32, u32), u32> = Default::default();
+        let first = mesh.vertices.len() as u32;
+        let mut points = Vec::new();
+        let mut node = |a: u32, b: u32| -> u32 {
+            let key = (a.min(b), a.max(b));
+            *ids.entry(key).or_insert_with(|| {
+                points.push((mesh.vertices[a as usize] + mesh.vertices[b as usize]) * 0.5);
+                first + points.len() as u32 - 1
+            })
+        };
+        let tet_edges = mesh
+            .tets
+            .iter()
+            .map(|t| TET_EDGES.map(|(i, j)| node(t[i], t[j])))
+            .collect();
+        let boundary_edges = mesh
+            .boundary
+            .iter()
+            .map(|t| TRIANGLE_EDGES.map(|(i, j)| node(t[i], t[j])))
+            .collect();
+        QuadraticNodes {
+            points,
+            tet_edges,
+            boundary_edges,
+        }
+    }
+
+    /// The position of node `id` (a corner vertex or a mid-edge node).
+    pub fn position(&self, mesh: &TetMesh, id: u32) -> DVec3 {
+        let first = mesh.vertices.len();
+        match (id as usize).checked_sub(first) {
+            Some(k) => self.points[k],
+            None => mesh.vertices[id as usize],
+        }
+    }
+
+    /// Node count of the ten-node mesh: corners plus mid-edge nodes.
+    pub fn n_nodes(&self, mesh: &TetMesh) -> usize {
+        mesh.vertices.len() + self.points.len()
+    }
+}

@@ -21,7 +21,7 @@
 //! `.stl`, `.ply` and `.obj` facets get their 1-based facet index (after the optional coplanar merge); mesh
 //! readers use 0 for a missing region or marker.
 
-use crate::mesh::TetMesh;
+use crate::mesh::{QuadraticNodes, TetMesh};
 use crate::plc::PlcInput;
 use std::path::Path;
 
@@ -169,6 +169,25 @@ pub fn write_mesh_in(
         "vtu" if binary => vtu_binary::write_vtu_binary(path, mesh, cell_fields),
         "msh" if binary => gmsh_binary::write_msh_binary(path, mesh),
         _ => write_mesh(path, mesh, cell_fields),
+    }
+}
+
+/// [`write_mesh_in`] for a mesh of ten-node tets when `quadratic` is given (`--order 2`),
+/// else of four-node tets. Node order per format: docs/formats.md.
+pub fn write_output(
+    path: &Path,
+    mesh: &TetMesh,
+    quadratic: Option<&QuadraticNodes>,
+    cell_fields: &[CellField],
+    binary: bool,
+) -> Result<(), IoError> {
+    match quadratic {
+        None => write_mesh_in(path, mesh, cell_fields, binary),
+        Some(_) => Err(IoError {
+            path: path.display().to_string(),
+            line: None,
+            message: "ten-node tets are not written yet".into(),
+        }),
     }
 }
 
