@@ -19,6 +19,7 @@ pub mod io;
 pub mod mesh;
 pub mod pipeline;
 pub mod plc;
+pub mod quadratic;
 pub mod quality;
 pub mod refine;
 pub mod surface;

@@ -2,20 +2,22 @@
 //! (kept as given, or approximated by `crate::approx`), refinement, then the improvement pass
 //! and the check that no tet is degenerate.
 
-use crate::mesh::TetMesh;
+use crate::mesh::{QuadraticNodes, TetMesh};
 use crate::plc::PlcInput;
 use crate::refine::{self, MeshError, Params, Progress, Report, Spacing, SurfaceMode};
 
 /// Meshes `input` in `params.surface_mode`, improves the result (`params.improve`) and checks
 /// that no tet is flat or inverted; the report gets each region's figures. `spacing` None =
-/// automatic.
+/// automatic. With `params.order` 2, the mid-edge nodes of ten-node tets come along
+/// (`crate::quadratic`): on the input surface in approximate mode, at the midpoints in keep
+/// mode, whose facets are planar.
 pub fn mesh(
     input: &PlcInput,
     params: &Params,
     spacing: Option<&dyn Spacing>,
     progress: Option<Progress>,
-) -> Result<(TetMesh, Report), MeshError> {
-    let (mesh, mut report) = match params.surface_mode {
+) -> Result<(TetMesh, Option<QuadraticNodes>, Report), MeshError> {
+    let (mesh, quadratic, mut report) = match params.surface_mode {
         SurfaceMode::Keep if params.repair => {
             return Err(MeshError::InvalidInput(
                 "repair needs the approximate surface mode: keep mode preserves every input \
@@ -26,10 +28,15 @@ pub fn mesh(
         SurfaceMode::Keep => {
             let (mesh, mut report) = refine::mesh(input, params, spacing, progress)?;
             let mesh = crate::improve::finish(mesh, &mut report, Some(input), params, None)?;
-            (mesh, report)
+            let quadratic = (params.order == 2).then(|| {
+                let (nodes, quadratic_report) = crate::quadratic::elevate(&mesh, None);
+                report.quadratic = Some(quadratic_report);
+                nodes
+            });
+            (mesh, quadratic, report)
         }
         SurfaceMode::Approximate => crate::approx::mesh(input, params, spacing, progress)?,
     };
     report.measure_regions(&mesh);
-    Ok((mesh, report))
+    Ok((mesh, quadratic, report))
 }

@@ -322,8 +322,15 @@ impl Mesher {
             (Ok(_), None) if cancelled => Err(MeshError::Cancelled),
             (r, None) => r,
         };
-        let (mesh, report) = result?;
-        Ok(&self.output.insert(MeshOutput { mesh, report }).report)
+        let (mesh, quadratic, report) = result?;
+        Ok(&self
+            .output
+            .insert(MeshOutput {
+                mesh,
+                quadratic,
+                report,
+            })
+            .report)
     }
 
     /// The domain as given so far.

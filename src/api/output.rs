@@ -3,7 +3,7 @@
 use super::error::Error;
 use crate::geom::TetQuality;
 use crate::io::CellField;
-use crate::mesh::TetMesh;
+use crate::mesh::{QuadraticNodes, TetMesh};
 use crate::refine::Report;
 use std::path::Path;
 
@@ -11,6 +11,8 @@ use std::path::Path;
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct MeshOutput {
     pub mesh: TetMesh,
+    /// With the `order` parameter 2: the mid-edge nodes of the ten-node tets.
+    pub quadratic: Option<QuadraticNodes>,
     pub report: Report,
 }
 
@@ -83,8 +85,9 @@ impl QualityFields {
 }
 
 impl MeshOutput {
-    /// Writes the mesh (format by extension: .vtu, .mesh, .msh, .node) with the per-tet quality
-    /// measures as cell data where the format has room for them.
+    /// Writes the mesh (format by extension: .vtu, .mesh, .msh, .node, .inp), ten-node tets
+    /// with `order` 2, with the per-tet quality measures (of the corner tets) as cell data
+    /// where the format has room for them.
     pub fn write(&self, path: &Path) -> Result<(), Error> {
         self.write_in(path, false)
     }
@@ -93,7 +96,13 @@ impl MeshOutput {
     /// (.msh: gmsh 4.1 binary; .vtu: binary appended arrays).
     pub fn write_in(&self, path: &Path, binary: bool) -> Result<(), Error> {
         let q = QualityFields::of(&self.mesh);
-        crate::io::write_mesh_in(path, &self.mesh, &q.cell_fields(), binary)?;
+        crate::io::write_output(
+            path,
+            &self.mesh,
+            self.quadratic.as_ref(),
+            &q.cell_fields(),
+            binary,
+        )?;
         Ok(())
     }
 }

@@ -26,6 +26,7 @@ pub const PARAM_NAMES: &[&str] = &[
     "surface_distance",
     "improve_target",
     "repair",
+    "order",
 ];
 
 /// Smallest accepted `rho0` (the refiner's own limit, `Params::check`).
@@ -51,7 +52,8 @@ const MAX_EXACT_INT: f64 = 9_007_199_254_740_992.0; // 2^53
 /// the bounding-box diagonal), `improve_target` (degrees in [0, 40]: improvement works on tets
 /// with a smaller dihedral angle; 0 = the mode's default, 26 keep / 20 approximate), `repair`
 /// (0 or 1: approximate mode meshes a dirty surface, open, self-intersecting or overlapping,
-/// as the solid where its winding number is at least 1/2). Integer and 0/1 parameters must be
+/// as the solid where its winding number is at least 1/2), `order` (1: four-node tets, 2:
+/// ten-node tets with boundary nodes on the input surface). Integer and 0/1 parameters must be
 /// given as whole numbers.
 /// The result also passes `Params::check` (the refiner's own validation), so a value accepted
 /// here is never refused by `refine`.
@@ -194,6 +196,18 @@ fn set_unchecked(params: &mut Params, name: &str, value: f64) -> Result<(), Erro
                 }
             }
         }
+        "order" => {
+            params.order = match value {
+                1.0 => 1,
+                2.0 => 2,
+                _ => {
+                    return invalid(format!(
+                        "order = {value}: must be 1 (four-node tets) or 2 (ten-node tets, \
+                         boundary nodes on the input surface)"
+                    ))
+                }
+            }
+        }
         "refine" => {
             params.refine = match value {
                 0.0 => false,
@@ -239,6 +253,7 @@ pub fn get_param(params: &Params, name: &str) -> Result<f64, Error> {
         "surface_distance" => params.surface_distance,
         "improve_target" => params.improve_target,
         "repair" => f64::from(u8::from(params.repair)),
+        "order" => f64::from(params.order),
         _ => {
             return invalid(format!(
                 "unknown parameter \"{name}\"; valid names: {}",
@@ -312,6 +327,7 @@ mod tests {
             ("surface_distance", 0.01),
             ("improve_target", 30.0),
             ("repair", 1.0),
+            ("order", 2.0),
         ];
         assert_eq!(values.len(), PARAM_NAMES.len());
         for (name, v) in values {
@@ -326,6 +342,8 @@ mod tests {
         assert!(p.repair);
         assert!(set_param(&mut p, "improve", 0.5).is_err());
         assert!(set_param(&mut p, "repair", 2.0).is_err());
+        assert!(set_param(&mut p, "order", 3.0).is_err());
+        assert!(set_param(&mut p, "order", 1.5).is_err());
     }
 
     #[test]

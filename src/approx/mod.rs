@@ -14,6 +14,7 @@
 //! 5. the report's surface figures measured on the written boundary (`measure`).
 
 mod curves;
+mod curving;
 mod measure;
 mod restricted;
 #[cfg(test)]
@@ -21,7 +22,7 @@ mod tests;
 
 pub use curves::SMALL_CORNER_DEG;
 
-use crate::mesh::TetMesh;
+use crate::mesh::{QuadraticNodes, TetMesh};
 use crate::plc::{Facet, PlcInput};
 use crate::refine::{
     AutoSpacing, ConstantSpacing, MeshError, Params, Progress, Report, Spacing,
@@ -110,7 +111,7 @@ pub fn mesh(
     params: &Params,
     spacing: Option<&dyn Spacing>,
     progress: Option<Progress>,
-) -> Result<(TetMesh, Report), MeshError> {
+) -> Result<(TetMesh, Option<QuadraticNodes>, Report), MeshError> {
     let start = std::time::Instant::now();
     let (remeshed, mesh, mut report, cell_spacing) =
         mesh_restricted(input, params, spacing, progress)?;
@@ -147,8 +148,24 @@ pub fn mesh(
     ) = measure::small_corner_figures(&mesh, &remeshed.small_corners, params);
     report.surface = Some(surface_report);
     report.input_regions = Some(remeshed.input_regions.clone());
+    let quadratic = (params.order == 2).then(|| {
+        let curving = curving::OnInputSurface {
+            oracle,
+            patch_of: &remeshed.features.patch_of,
+            curves: &remeshed.curves,
+            vertex_slide: &remeshed.vertex_slide,
+            feature_edges: remeshed
+                .feature_edges
+                .iter()
+                .map(|&[a, b]| (a.min(b), a.max(b)))
+                .collect(),
+        };
+        let (nodes, quadratic_report) = crate::quadratic::elevate(&mesh, Some(&curving));
+        report.quadratic = Some(quadratic_report);
+        nodes
+    });
     report.seconds_total = start.elapsed().as_secs_f64();
-    Ok((mesh, report))
+    Ok((mesh, quadratic, report))
 }
 
 /// The report's figures of the final `mesh` (sizes against `f`), and whether it is complete:

@@ -4,7 +4,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use slivermesh::geom::TetQuality;
 use slivermesh::improve;
 use slivermesh::io::{self, ReadOptions};
-use slivermesh::mesh::TetMesh;
+use slivermesh::mesh::{QuadraticNodes, TetMesh};
 use slivermesh::pipeline;
 use slivermesh::plc::{Facet, PlcInput, Region};
 use slivermesh::refine::{
@@ -83,6 +83,11 @@ pub struct MeshOptions {
     /// .vtu: binary appended arrays); the other formats are written as usual.
     #[arg(long)]
     pub binary: bool,
+    /// Element order: 1 (four-node tets) or 2 (ten-node tets; in approximate mode the boundary
+    /// edges' nodes lie on the input surface, on the feature curve for feature edges; a tet
+    /// that curving would fold keeps straight edges). Node order per format: docs/formats.md.
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=2))]
+    pub order: u8,
 }
 
 /// `--surface`: how the input facets bound the domain (`refine::SurfaceMode`).
@@ -121,6 +126,7 @@ impl MeshOptions {
             improve: !self.no_improve,
             surface_mode: self.surface_mode(input),
             repair: self.repair,
+            order: self.order,
             ..Params::default()
         };
         if let Some(v) = self.feature_angle {
@@ -189,7 +195,7 @@ pub fn run_mesh(
     let is_mesh = input
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("mesh"));
-    let (mesh, report) = if is_mesh {
+    let (mesh, quadratic, report) = if is_mesh {
         if opts.surface == Some(SurfaceArg::Approximate) {
             return Err(format!(
                 "{}: --surface approximate does not apply to an existing mesh (.mesh): its \
@@ -203,7 +209,12 @@ pub fn run_mesh(
         // The existing mesh's boundary stays as it is (no facet description to move within).
         let mesh =
             improve::finish(mesh, &mut report, None, &params, None).map_err(|e| e.to_string())?;
-        (mesh, report)
+        let quadratic = (params.order == 2).then(|| {
+            let (nodes, quadratic_report) = slivermesh::quadratic::elevate(&mesh, None);
+            report.quadratic = Some(quadratic_report);
+            nodes
+        });
+        (mesh, quadratic, report)
     } else {
         let merge = !opts.no_merge && io::is_surface_file(input);
         let plc = io::read_plc(
@@ -215,7 +226,12 @@ pub fn run_mesh(
         .map_err(|e| e.to_string())?;
         mesh_with_progress(&plc, &params, spacing)?
     };
-    finish(&mesh, &report, output, stats_json, quality_svg, opts.binary)
+    let written = Written {
+        mesh: &mesh,
+        quadratic: quadratic.as_ref(),
+        binary: opts.binary,
+    };
+    finish(written, &report, output, stats_json, quality_svg)
 }
 
 /// `pipeline::mesh` (the surface mode, refinement, improvement) with a spinner on a terminal.
@@ -223,7 +239,7 @@ fn mesh_with_progress(
     plc: &PlcInput,
     params: &Params,
     spacing: Option<&dyn Spacing>,
-) -> Result<(TetMesh, Report), String> {
+) -> Result<(TetMesh, Option<QuadraticNodes>, Report), String> {
     let bar = if std::io::stderr().is_terminal() {
         let b = ProgressBar::new_spinner();
         b.set_style(
@@ -248,17 +264,28 @@ fn mesh_with_progress(
     r.map_err(|e| e.to_string())
 }
 
+/// The output as written: the tets, their mid-edge nodes with `--order 2`, and `--binary`.
+#[derive(Clone, Copy)]
+pub struct Written<'a> {
+    pub mesh: &'a TetMesh,
+    pub quadratic: Option<&'a QuadraticNodes>,
+    pub binary: bool,
+}
+
 fn finish(
-    mesh: &TetMesh,
+    written: Written,
     report: &Report,
     output: Option<&Path>,
     stats_json: Option<&Path>,
     quality_svg: Option<&Path>,
-    binary: bool,
 ) -> Result<(), String> {
+    let mesh = written.mesh;
     println!("{}", report.table());
     if let Some(surface) = &report.surface {
         println!("{}", surface_table(surface));
+    }
+    if let Some(q) = &report.quadratic {
+        println!("{}", quadratic_table(q));
     }
     if let Some(path) = stats_json {
         let json = serde_json::to_string_pretty(report).map_err(|e| e.to_string())?;
@@ -267,7 +294,7 @@ fn finish(
     // Every tet measured once, for the .vtu's cell data and the quality table.
     let per_tet = slivermesh::quality::per_tet(mesh).ok();
     if let Some(path) = output {
-        write_with_quality(path, mesh, per_tet.as_deref(), binary)?;
+        write_with_quality(path, written, per_tet.as_deref())?;
         println!("wrote {}", path.display());
     }
     // Measured on the mesh as written, the table `slivermesh quality` prints for that file.
@@ -345,21 +372,42 @@ fn surface_table(s: &SurfaceReport) -> String {
     out
 }
 
+/// The report's "quadratic" section (`--order 2`).
+fn quadratic_table(q: &slivermesh::quadratic::QuadraticReport) -> String {
+    format!(
+        "ten-node tets (--order 2)\n  \
+         mid-edge nodes                   {}\n  \
+         boundary edges / curved          {} / {}\n  \
+         curved edges straightened        {}\n  \
+         min scaled Jacobian (corners)    {:.4}\n  \
+         min Jacobian ratio (bound)       {:.4}",
+        q.n_edge_nodes,
+        q.n_boundary_edges,
+        q.n_curved_edges,
+        q.n_straightened_edges,
+        q.min_scaled_jacobian,
+        q.min_jacobian_ratio
+    )
+}
+
 /// Writes the mesh, with per-tet quality as cell data (`api::QualityFields`)
-/// when the format is .vtu: from `per_tet` (`quality::per_tet`) when given. `binary`: a .msh or
-/// .vtu is written in its binary form.
+/// when the format is .vtu: from `per_tet` (`quality::per_tet`) when given.
 pub fn write_with_quality(
     path: &Path,
-    mesh: &TetMesh,
+    written: Written,
     per_tet: Option<&[TetQuality]>,
-    binary: bool,
 ) -> Result<(), String> {
+    let Written {
+        mesh,
+        quadratic,
+        binary,
+    } = written;
     // Only .vtu has a place for cell data: measuring every tet for another format is wasted.
     if !path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("vtu"))
     {
-        return io::write_mesh_in(path, mesh, &[], binary).map_err(|e| e.to_string());
+        return io::write_output(path, mesh, quadratic, &[], binary).map_err(|e| e.to_string());
     }
     let measured;
     let per_tet = match per_tet {
@@ -370,7 +418,8 @@ pub fn write_with_quality(
         }
     };
     let fields = slivermesh::api::QualityFields::from_measures(per_tet);
-    io::write_mesh_in(path, mesh, &fields.cell_fields(), binary).map_err(|e| e.to_string())
+    io::write_output(path, mesh, quadratic, &fields.cell_fields(), binary)
+        .map_err(|e| e.to_string())
 }
 
 /// The built-in model: a 2 x 1 x 1 box of two materials (x < 1: region 1, x > 1: region 2)
@@ -428,14 +477,18 @@ pub fn run_demo() -> Result<(), String> {
     let plc = demo_model();
     let f = FnSpacing(|p: DVec3| 0.02 + 0.1 * p.length());
     let params = Params::default();
-    let (mesh, report) = mesh_with_progress(&plc, &params, Some(&f))?;
+    let (mesh, _, report) = mesh_with_progress(&plc, &params, Some(&f))?;
+    let written = Written {
+        mesh: &mesh,
+        quadratic: None,
+        binary: false,
+    };
     finish(
-        &mesh,
+        written,
         &report,
         Some(Path::new("slivermesh-demo.vtu")),
         None,
         None,
-        false,
     )
 }
 

@@ -80,6 +80,9 @@ pub struct Params {
     /// duplicated) as the solid where its generalized winding number is at least 1/2
     /// (`crate::surface::repair`) instead of refusing it.
     pub repair: bool,
+    /// Element order of the output: 1 (four-node tets) or 2 (ten-node tets, boundary nodes on
+    /// the input surface where the surface mode knows it; `crate::quadratic`).
+    pub order: u8,
 }
 
 /// Default improvement target (degrees) in keep mode: every acute-free model reaches 25.
@@ -123,6 +126,7 @@ impl Default for Params {
             surface_distance: 0.0,
             improve_target: 0.0,
             repair: false,
+            order: 1,
         }
     }
 }
@@ -155,6 +159,12 @@ impl Params {
                     "parameter {name} = {v} must be finite and positive"
                 ));
             }
+        }
+        if !matches!(self.order, 1 | 2) {
+            return Err(format!(
+                "parameter order = {} must be 1 (four-node tets) or 2 (ten-node tets)",
+                self.order
+            ));
         }
         if self.small_angle_reach.is_nan() || self.small_angle_reach <= 0.0 {
             return Err(format!(
@@ -306,6 +316,8 @@ pub struct Report {
     pub improvement: crate::improve::Stats,
     /// Approximate surface mode only: how close the output boundary is to the input surface.
     pub surface: Option<SurfaceReport>,
+    /// With `order` 2: the ten-node tets' curving and validity.
+    pub quadratic: Option<crate::quadratic::QuadraticReport>,
     /// Per region attribute of the output (sorted): its tets and volume against the input's.
     pub regions: Vec<RegionReport>,
     /// Area of the output faces between tets of different regions, and of the input's.
