@@ -231,6 +231,32 @@ module slivermesh
       integer(c_int32_t) :: s
     end function sm_get_vertices
 
+    !> With sm_set_param(m, "order", 2d0): vertices, then one node per edge.
+    function sm_num_nodes(m) bind(C, name="sm_num_nodes") result(n)
+      import :: c_ptr, c_size_t
+      type(c_ptr), value :: m
+      integer(c_size_t) :: n
+    end function sm_num_nodes
+
+    !> xyz(3, capacity): the vertices, then the mid-edge nodes of ten-node tets.
+    function sm_get_nodes(m, xyz, capacity) bind(C, name="sm_get_nodes") result(s)
+      import :: c_ptr, c_double, c_size_t, c_int32_t
+      type(c_ptr), value :: m
+      real(c_double), intent(inout) :: xyz(*)
+      integer(c_size_t), value :: capacity
+      integer(c_int32_t) :: s
+    end function sm_get_nodes
+
+    !> tets10(10, capacity) 0-based node ids: corners, then edges 01 12 02 03 13 23
+    !> (VTK_QUADRATIC_TETRA / Abaqus C3D10 order). Needs "order" 2.
+    function sm_get_tets10(m, tets10, capacity) bind(C, name="sm_get_tets10") result(s)
+      import :: c_ptr, c_size_t, c_int32_t
+      type(c_ptr), value :: m
+      integer(c_int32_t), intent(inout) :: tets10(*)
+      integer(c_size_t), value :: capacity
+      integer(c_int32_t) :: s
+    end function sm_get_tets10
+
     !> tets(4, capacity) 0-based ids; regions(capacity) may be omitted (NULL). Regions: the
     !> seeds' attributes, else 1, 2, ... per enclosed volume (0 for one piece), see slivermesh.h.
     function sm_get_tets(m, tets, regions, capacity) bind(C, name="sm_get_tets") result(s)
@@ -326,7 +352,8 @@ module slivermesh
             sm_add_hole, sm_add_region, sm_set_spacing_cb, sm_set_spacing_batch_cb, &
             sm_set_spacing_const, sm_set_spacing_mesh, sm_set_param_c, sm_get_param_c, sm_set_progress_cb, &
             sm_refine, sm_num_vertices, sm_num_tets, sm_num_boundary_faces, sm_get_vertices, &
-            sm_get_tets, sm_get_boundary_faces, sm_get_quality, sm_num_regions, sm_get_regions, &
+            sm_get_tets, sm_get_boundary_faces, sm_get_quality, sm_num_nodes, sm_get_nodes, &
+            sm_get_tets10, sm_num_regions, sm_get_regions, &
             sm_write_c, sm_write_binary_c, sm_last_error_c, &
             sm_stop_reason_c, sm_status_str_c, sm_version_c
   public :: sm_set_param, sm_get_param, sm_write, sm_write_binary, sm_last_error, &

@@ -344,7 +344,9 @@ sm_status sm_add_region(sm_mesher *m,
  * mode and 20 in approximate mode), "repair" (approximate mode: 1 meshes a dirty surface,
  * open, self-intersecting, overlapping or with duplicated triangles, as the solid where its
  * generalized winding number is at least 1/2; 0, the default, refuses it with the error that
- * names the defect).
+ * names the defect), "order" (1, the default: four-node tets; 2: ten-node tets as well, read
+ * with `sm_num_nodes`, `sm_get_nodes` and `sm_get_tets10`; in approximate mode the boundary
+ * edges' nodes lie on the input surface).
  * An unknown name or out-of-range value gives `SM_ERR_INVALID_ARGUMENT`; `sm_last_error`
  * says why (and lists the valid names).
  *
@@ -486,6 +488,40 @@ sm_status sm_get_vertices(const sm_mesher *m, double *xyz, size_t capacity);
  * `regions` is NULL or points to `capacity` writable ints.
  */
 sm_status sm_get_tets(const sm_mesher *m, uint32_t *tets, int32_t *regions, size_t capacity);
+
+/**
+ * Number of nodes of the ten-node mesh (`sm_set_param(m, "order", 2)`): the vertices, then
+ * one node per edge; `sm_num_vertices(m)` with order 1, and 0 before a successful
+ * `sm_refine`.
+ *
+ * # Safety
+ * `m` is NULL or a live handle.
+ */
+size_t sm_num_nodes(const sm_mesher *m);
+
+/**
+ * Copies the coordinates of every node into `xyz` (x0 y0 z0 x1 ...), which holds `capacity`
+ * nodes: the vertices as `sm_get_vertices` gives them, then with order 2 the mid-edge nodes
+ * (on the input surface for curved boundary edges). `SM_ERR_BUFFER_TOO_SMALL` if
+ * `capacity < sm_num_nodes(m)`; nothing is written unless the call succeeds.
+ *
+ * # Safety
+ * `m` is NULL or a live handle; `xyz` is NULL or points to `3 * capacity` writable doubles.
+ */
+sm_status sm_get_nodes(const sm_mesher *m, double *xyz, size_t capacity);
+
+/**
+ * Copies the ten-node tets into `tets10` (10 node ids per tet, 0-based, indices into
+ * `sm_get_nodes`): the four corners as `sm_get_tets` gives them, then the nodes of edges
+ * 01, 12, 02, 03, 13, 23 (VTK's VTK_QUADRATIC_TETRA and Abaqus C3D10 order). Holds `capacity`
+ * tets. `SM_ERR_NOT_REFINED` unless the last `sm_refine` ran with `"order"` 2;
+ * `SM_ERR_BUFFER_TOO_SMALL` if `capacity < sm_num_tets(m)`; nothing is written unless the
+ * call succeeds.
+ *
+ * # Safety
+ * `m` is NULL or a live handle; `tets10` is NULL or points to `10 * capacity` writable ids.
+ */
+sm_status sm_get_tets10(const sm_mesher *m, uint32_t *tets10, size_t capacity);
 
 /**
  * Copies the boundary triangles into `tris` (3 vertex ids each) and, if `markers` is not NULL,

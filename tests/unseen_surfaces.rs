@@ -429,7 +429,7 @@ fn several_regions_in_keep_mode() {
             surface_mode: slivermesh::refine::SurfaceMode::Keep,
             ..Default::default()
         };
-        let (mesh, report) = slivermesh::pipeline::mesh(&input, &params, None, None)
+        let (mesh, _, report) = slivermesh::pipeline::mesh(&input, &params, None, None)
             .unwrap_or_else(|e| panic!("{}: {e}", shape.name));
         let labels: Vec<i32> = report.regions.iter().map(|r| r.attribute).collect();
         let want: Vec<i32> = (1..=shape.part_volumes.len() as i32).collect();

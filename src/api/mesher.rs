@@ -391,6 +391,10 @@ impl Mesher {
     /// Installs a result without meshing (tests of the output paths).
     #[cfg(test)]
     pub(crate) fn set_output_for_test(&mut self, mesh: TetMesh, report: Report) {
-        self.output = Some(MeshOutput { mesh, report });
+        self.output = Some(MeshOutput {
+            mesh,
+            quadratic: None,
+            report,
+        });
     }
 }

@@ -31,7 +31,7 @@ fn explore() {
     let name = std::env::var("SM_MODEL").unwrap_or_else(|_| "off/cube.off".into());
     let input = model(&name);
     let t = std::time::Instant::now();
-    let (mesh, report) = mesh(&input, &approximate(), None, None).unwrap();
+    let (mesh, _, report) = mesh(&input, &approximate(), None, None).unwrap();
     let q = crate::quality::measure(&mesh).unwrap();
     println!(
         "{name}: {} tets in {:.2}s",
@@ -46,7 +46,7 @@ fn check_mesh(name: &str, size: Option<f64>) -> (TetMesh, Report) {
     let input = model(name);
     let spacing = size.map(ConstantSpacing);
     let f = spacing.as_ref().map(|s| s as &dyn Spacing);
-    let (mesh, report) = mesh(&input, &approximate(), f, None).unwrap();
+    let (mesh, _, report) = mesh(&input, &approximate(), f, None).unwrap();
     // Every tet positively oriented by the exact predicate.
     for (k, t) in mesh.tets.iter().enumerate() {
         let [a, b, c, d] = t.map(|v| mesh.vertices[v as usize]);
@@ -210,7 +210,7 @@ fn open_surface_is_refused_in_approximate_mode() {
 #[test]
 fn two_materials_keep_their_attributes_and_interface() {
     let input = model("poly/two_materials.poly");
-    let (m, _) = crate::pipeline::mesh(&input, &approximate(), None, None).unwrap();
+    let (m, _, _) = crate::pipeline::mesh(&input, &approximate(), None, None).unwrap();
     let mut volume: std::collections::BTreeMap<i32, f64> = Default::default();
     let mut faces: std::collections::HashMap<[u32; 3], Vec<i32>> = Default::default();
     for (t, &r) in m.tets.iter().zip(&m.tet_regions) {
@@ -390,7 +390,7 @@ fn thin_scans_complete() {
         ("dino", 18.0, 1.0),
     ] {
         let input = model(&format!("scans/{name}.off"));
-        let (mesh, report) = mesh(&input, &approximate(), None, None).unwrap();
+        let (mesh, _, report) = mesh(&input, &approximate(), None, None).unwrap();
         for t in &mesh.tets {
             let [a, b, c, d] = t.map(|v| mesh.vertices[v as usize]);
             assert!(crate::geom::orient3d(a, b, c, d) > 0.0, "{name}");

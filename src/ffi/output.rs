@@ -115,6 +115,100 @@ pub unsafe extern "C" fn sm_get_tets(
     })
 }
 
+/// Number of nodes of the ten-node mesh (`sm_set_param(m, "order", 2)`): the vertices, then
+/// one node per edge; `sm_num_vertices(m)` with order 1, and 0 before a successful
+/// `sm_refine`.
+///
+/// # Safety
+/// `m` is NULL or a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn sm_num_nodes(m: *const sm_mesher) -> usize {
+    // SAFETY: `m` is NULL or a live handle (contract above).
+    let handle = unsafe { m.as_ref() };
+    handle_query(handle, "sm_num_nodes", 0, |st| {
+        st.mesher.output().map_or(0, |o| match &o.quadratic {
+            Some(q) => q.n_nodes(&o.mesh),
+            None => o.mesh.vertices.len(),
+        })
+    })
+}
+
+/// Copies the coordinates of every node into `xyz` (x0 y0 z0 x1 ...), which holds `capacity`
+/// nodes: the vertices as `sm_get_vertices` gives them, then with order 2 the mid-edge nodes
+/// (on the input surface for curved boundary edges). `SM_ERR_BUFFER_TOO_SMALL` if
+/// `capacity < sm_num_nodes(m)`; nothing is written unless the call succeeds.
+///
+/// # Safety
+/// `m` is NULL or a live handle; `xyz` is NULL or points to `3 * capacity` writable doubles.
+#[no_mangle]
+pub unsafe extern "C" fn sm_get_nodes(
+    m: *const sm_mesher,
+    xyz: *mut f64,
+    capacity: usize,
+) -> sm_status {
+    // SAFETY: `m` is NULL or a live handle (contract above).
+    let handle = unsafe { m.as_ref() };
+    handle_call(handle, "sm_get_nodes", |st| {
+        let mesh = st.mesher.mesh()?;
+        let mids: &[crate::DVec3] = st
+            .mesher
+            .output()
+            .and_then(|o| o.quadratic.as_ref())
+            .map_or(&[], |q| &q.points);
+        let n = mesh.vertices.len() + mids.len();
+        // SAFETY: `xyz` is NULL or holds 3 * capacity doubles (contract above).
+        let out = unsafe { output("xyz", xyz, capacity, n, 3) }?;
+        for (o, v) in out.chunks_exact_mut(3).zip(mesh.vertices.iter().chain(mids)) {
+            o.copy_from_slice(&v.to_array());
+        }
+        Ok(())
+    })
+}
+
+/// Copies the ten-node tets into `tets10` (10 node ids per tet, 0-based, indices into
+/// `sm_get_nodes`): the four corners as `sm_get_tets` gives them, then the nodes of edges
+/// 01, 12, 02, 03, 13, 23 (VTK's VTK_QUADRATIC_TETRA and Abaqus C3D10 order). Holds `capacity`
+/// tets. `SM_ERR_NOT_REFINED` unless the last `sm_refine` ran with `"order"` 2;
+/// `SM_ERR_BUFFER_TOO_SMALL` if `capacity < sm_num_tets(m)`; nothing is written unless the
+/// call succeeds.
+///
+/// # Safety
+/// `m` is NULL or a live handle; `tets10` is NULL or points to `10 * capacity` writable ids.
+#[no_mangle]
+pub unsafe extern "C" fn sm_get_tets10(
+    m: *const sm_mesher,
+    tets10: *mut u32,
+    capacity: usize,
+) -> sm_status {
+    // SAFETY: `m` is NULL or a live handle (contract above).
+    let handle = unsafe { m.as_ref() };
+    handle_call(handle, "sm_get_tets10", |st| {
+        let mesh = st.mesher.mesh()?;
+        let quadratic = st
+            .mesher
+            .output()
+            .and_then(|o| o.quadratic.as_ref())
+            .ok_or_else(|| {
+                FfiError::new(
+                    SM_ERR_NOT_REFINED,
+                    "no ten-node tets: set the parameter \"order\" to 2 before sm_refine",
+                )
+            })?;
+        let n = mesh.tets.len();
+        // SAFETY: `tets10` is NULL or holds 10 * capacity ids (contract above).
+        let out = unsafe { output("tets10", tets10, capacity, n, 10) }?;
+        for ((o, t), e) in out
+            .chunks_exact_mut(10)
+            .zip(&mesh.tets)
+            .zip(&quadratic.tet_edges)
+        {
+            o[..4].copy_from_slice(t);
+            o[4..].copy_from_slice(e);
+        }
+        Ok(())
+    })
+}
+
 /// Copies the boundary triangles into `tris` (3 vertex ids each) and, if `markers` is not NULL,
 /// each triangle's input facet marker into `markers`. Both hold `capacity` triangles. An
 /// interface between two regions is among them once (its face is shared by one tet of each

@@ -29,7 +29,9 @@ use std::ffi::{c_char, c_void};
 /// mode and 20 in approximate mode), "repair" (approximate mode: 1 meshes a dirty surface,
 /// open, self-intersecting, overlapping or with duplicated triangles, as the solid where its
 /// generalized winding number is at least 1/2; 0, the default, refuses it with the error that
-/// names the defect).
+/// names the defect), "order" (1, the default: four-node tets; 2: ten-node tets as well, read
+/// with `sm_num_nodes`, `sm_get_nodes` and `sm_get_tets10`; in approximate mode the boundary
+/// edges' nodes lie on the input surface).
 /// An unknown name or out-of-range value gives `SM_ERR_INVALID_ARGUMENT`; `sm_last_error`
 /// says why (and lists the valid names).
 ///

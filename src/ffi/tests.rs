@@ -700,3 +700,51 @@ fn regions_through_the_c_abi() {
         assert!((area - 1.0).abs() < 1e-9 && (input_area - 1.0).abs() < 1e-12);
     }
 }
+
+/// Ten-node tets through the C ABI: refused before `"order"` 2, then corners as `sm_get_tets`
+/// gives them and (keep mode: planar facets) every edge node at its edge's midpoint.
+#[test]
+fn ten_node_tets_through_the_c_abi() {
+    let h = cube();
+    let order = std::ffi::CString::new("order").unwrap();
+    // SAFETY: live handle; buffers sized from the counts.
+    unsafe {
+        assert_eq!(sm_set_spacing_const(h.0, 0.4), SM_OK);
+        assert_eq!(sm_refine(h.0), SM_OK, "{}", last_error(&h));
+        let nt = sm_num_tets(h.0);
+        assert_eq!(sm_num_nodes(h.0), sm_num_vertices(h.0));
+        let mut tets10 = vec![0u32; 10 * nt];
+        assert_eq!(
+            sm_get_tets10(h.0, tets10.as_mut_ptr(), nt),
+            SM_ERR_NOT_REFINED
+        );
+        assert!(last_error(&h).contains("order"), "{}", last_error(&h));
+
+        assert_eq!(sm_set_param(h.0, order.as_ptr(), 2.0), SM_OK);
+        assert_eq!(sm_refine(h.0), SM_OK, "{}", last_error(&h));
+        let (nv, nt, nn) = (sm_num_vertices(h.0), sm_num_tets(h.0), sm_num_nodes(h.0));
+        assert!(nn > nv);
+        let mut xyz = vec![0.0; 3 * nn];
+        let mut tets = vec![0u32; 4 * nt];
+        let mut tets10 = vec![0u32; 10 * nt];
+        assert_eq!(sm_get_nodes(h.0, xyz.as_mut_ptr(), nn), SM_OK);
+        assert_eq!(sm_get_tets(h.0, tets.as_mut_ptr(), null_mut(), nt), SM_OK);
+        assert_eq!(
+            sm_get_tets10(h.0, tets10.as_mut_ptr(), nt - 1),
+            SM_ERR_BUFFER_TOO_SMALL
+        );
+        assert_eq!(sm_get_tets10(h.0, tets10.as_mut_ptr(), nt), SM_OK);
+        let p = |i: u32| DVec3::from_slice(&xyz[3 * i as usize..]);
+        let mut mids = std::collections::HashSet::new();
+        for (t4, t10) in tets.chunks_exact(4).zip(tets10.chunks_exact(10)) {
+            assert_eq!(t4, &t10[..4]);
+            for (e, &(i, j)) in crate::mesh::TET_EDGES.iter().enumerate() {
+                let node = t10[4 + e];
+                assert!((node as usize) >= nv && (node as usize) < nn);
+                assert!(p(node).distance((p(t4[i]) + p(t4[j])) * 0.5) < 1e-12);
+                mids.insert(node);
+            }
+        }
+        assert_eq!(mids.len(), nn - nv, "every node belongs to an edge");
+    }
+}
