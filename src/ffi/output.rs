@@ -158,7 +158,10 @@ pub unsafe extern "C" fn sm_get_nodes(
         let n = mesh.vertices.len() + mids.len();
         // SAFETY: `xyz` is NULL or holds 3 * capacity doubles (contract above).
         let out = unsafe { output("xyz", xyz, capacity, n, 3) }?;
-        for (o, v) in out.chunks_exact_mut(3).zip(mesh.vertices.iter().chain(mids)) {
+        for (o, v) in out
+            .chunks_exact_mut(3)
+            .zip(mesh.vertices.iter().chain(mids))
+        {
             o.copy_from_slice(&v.to_array());
         }
         Ok(())

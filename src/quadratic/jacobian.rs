@@ -75,7 +75,9 @@ fn values_to_bernstein() -> &'static [[f64; 20]; 20] {
                     let f = a[r][col];
                     if f != 0.0 {
                         let pivot_row = a[col];
-                        a[r].iter_mut().zip(pivot_row).for_each(|(x, y)| *x -= f * y);
+                        a[r].iter_mut()
+                            .zip(pivot_row)
+                            .for_each(|(x, y)| *x -= f * y);
                     }
                 }
             }

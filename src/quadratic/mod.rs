@@ -144,8 +144,7 @@ fn straighten_folds(mesh: &TetMesh, nodes: &mut QuadraticNodes, curved: &mut [bo
             for (e, &n) in nodes.tet_edges[t].iter().enumerate() {
                 if is_curved(curved, n) {
                     let (i, j) = crate::mesh::TET_EDGES[e];
-                    nodes.points[(n - first) as usize] = (mesh.vertices
-                        [corners[i] as usize]
+                    nodes.points[(n - first) as usize] = (mesh.vertices[corners[i] as usize]
                         + mesh.vertices[corners[j] as usize])
                         * 0.5;
                     curved[(n - first) as usize] = false;

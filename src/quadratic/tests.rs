@@ -79,7 +79,11 @@ fn cube() -> TetMesh {
         let t = [0, path[0], path[0] | path[1], 7];
         let [a, b, c, d] = t.map(|v: u32| vertices[v as usize]);
         let det = (b - a).dot((c - a).cross(d - a));
-        tets.push(if det > 0.0 { t } else { [t[1], t[0], t[2], t[3]] });
+        tets.push(if det > 0.0 {
+            t
+        } else {
+            [t[1], t[0], t[2], t[3]]
+        });
     }
     let mut boundary = Vec::new();
     for axis in 0..3 {
@@ -148,12 +152,7 @@ impl BoundaryCurving for Lift {
 #[test]
 fn a_dent_that_would_fold_is_straightened() {
     // A flat tet: its base edges lifted above its apex would fold it.
-    let corners = vec![
-        DVec3::ZERO,
-        DVec3::X,
-        DVec3::Y,
-        DVec3::new(0.3, 0.3, 0.1),
-    ];
+    let corners = vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(0.3, 0.3, 0.1)];
     let mesh = TetMesh {
         vertices: corners,
         tets: vec![[0, 1, 2, 3]],
