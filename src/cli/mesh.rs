@@ -379,12 +379,14 @@ fn quadratic_table(q: &slivermesh::quadratic::QuadraticReport) -> String {
          mid-edge nodes                   {}\n  \
          boundary edges / curved          {} / {}\n  \
          curved edges straightened        {}\n  \
+         interior nodes moved             {}\n  \
          min scaled Jacobian (corners)    {:.4}\n  \
          min Jacobian ratio (bound)       {:.4}",
         q.n_edge_nodes,
         q.n_boundary_edges,
         q.n_curved_edges,
         q.n_straightened_edges,
+        q.n_moved_interior_nodes,
         q.min_scaled_jacobian,
         q.min_jacobian_ratio
     )
