@@ -9,10 +9,16 @@
 //! S3 = (2, 4, 3), S4 = (3, 4, 1). A negative attribute or marker is written `M` and its
 //! absolute value (`REGION_M1`). An interface triangle (a face of two tets) is given on the tet
 //! its normal points out of. Writing only.
+//!
+//! Ten-node tets ([`format_inp_quadratic`]): `*NODE` lists the corners, then the mid-edge
+//! nodes; the elements are `TYPE=C3D10` with the corners and then the nodes of the edges
+//! (1,2), (2,3), (3,1), (1,4), (2,4), (3,4), Abaqus's C3D10 order (the mesh's own); sets and
+//! surfaces are the same, C3D10 numbering its faces as C3D4 does.
 
-use super::text::{create, write_err, F};
+use super::elements::{Elements, TET_ORDER};
+use super::text::{check_mesh, check_quadratic, create, with_path, write_err, F};
 use super::IoError;
-use crate::mesh::TetMesh;
+use crate::mesh::{QuadraticNodes, TetMesh};
 use rustc_hash::FxHashMap;
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -25,6 +31,20 @@ const FACE_OPPOSITE: [u8; 4] = [3, 4, 2, 1];
 pub fn write_inp(path: &Path, mesh: &TetMesh) -> Result<(), IoError> {
     let mut w = create(path)?;
     format_inp(&mut w, mesh)
+        .and_then(|_| w.flush())
+        .map_err(|e| write_err(path, e))
+}
+
+/// Writes `mesh` with its mid-edge nodes as an Abaqus `.inp` file of C3D10 elements.
+pub fn write_inp_quadratic(
+    path: &Path,
+    mesh: &TetMesh,
+    quadratic: &QuadraticNodes,
+) -> Result<(), IoError> {
+    check_mesh(mesh, &[]).map_err(|e| with_path(e, path))?;
+    check_quadratic(mesh, quadratic).map_err(|e| with_path(e, path))?;
+    let mut w = create(path)?;
+    format_inp_quadratic(&mut w, mesh, quadratic)
         .and_then(|_| w.flush())
         .map_err(|e| write_err(path, e))
 }
@@ -74,28 +94,54 @@ fn boundary_faces(mesh: &TetMesh) -> Vec<Option<(usize, u8)>> {
 /// Writes `mesh` in Abaqus `.inp` format to any writer.
 pub fn format_inp<W: Write>(w: &mut W, mesh: &TetMesh) -> std::io::Result<()> {
     super::text::check_mesh_io(mesh, &[])?;
+    format_elements(w, &Elements::new(mesh, None))
+}
+
+/// Writes `mesh` with its mid-edge nodes as C3D10 elements in Abaqus `.inp` format (nodes:
+/// the corners, then the mid-edge nodes; element sets and surfaces as in [`format_inp`]).
+/// An inconsistent mesh is an `InvalidInput` error.
+pub fn format_inp_quadratic<W: Write>(
+    w: &mut W,
+    mesh: &TetMesh,
+    quadratic: &QuadraticNodes,
+) -> std::io::Result<()> {
+    super::text::check_mesh_io(mesh, &[])?;
+    super::text::check_quadratic_io(mesh, quadratic)?;
+    format_elements(w, &Elements::new(mesh, Some(quadratic)))
+}
+
+fn format_elements<W: Write>(w: &mut W, el: &Elements) -> std::io::Result<()> {
+    let mesh = el.mesh;
+    let ty = if el.is_quadratic() { "C3D10" } else { "C3D4" };
     writeln!(w, "*HEADING")?;
     writeln!(
         w,
-        "slivermesh {}: {} nodes, {} C3D4 elements, {} boundary faces",
+        "slivermesh {}: {} nodes, {} {ty} elements, {} boundary faces",
         env!("CARGO_PKG_VERSION"),
-        mesh.vertices.len(),
+        el.n_nodes(),
         mesh.tets.len(),
         mesh.boundary.len()
     )?;
     writeln!(w, "*NODE, NSET=ALL_NODES")?;
-    for (i, p) in mesh.vertices.iter().enumerate() {
+    for (i, p) in el.nodes().enumerate() {
         writeln!(w, "{}, {}, {}, {}", i + 1, F(p.x), F(p.y), F(p.z))?;
     }
     let mut regions: BTreeMap<i32, Vec<usize>> = BTreeMap::new();
     for (t, &r) in mesh.tet_regions.iter().enumerate() {
         regions.entry(r).or_default().push(t);
     }
+    let mut line = String::new();
     for (&r, tets) in &regions {
-        writeln!(w, "*ELEMENT, TYPE=C3D4, ELSET={}", name("REGION", r))?;
+        writeln!(w, "*ELEMENT, TYPE={ty}, ELSET={}", name("REGION", r))?;
         for &t in tets {
-            let [a, b, c, d] = mesh.tets[t].map(|v| v as usize + 1);
-            writeln!(w, "{}, {a}, {b}, {c}, {d}", t + 1)?;
+            // Abaqus data lines hold at most 16 entries: an element number and 10 nodes fit.
+            line.clear();
+            line.push_str(itoa::Buffer::new().format(t + 1));
+            for v in el.tet_in(t, &TET_ORDER) {
+                line.push_str(", ");
+                line.push_str(itoa::Buffer::new().format(v as usize + 1));
+            }
+            writeln!(w, "{line}")?;
         }
     }
     if !mesh.tets.is_empty() {

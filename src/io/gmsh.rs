@@ -17,21 +17,29 @@
 //!   surfaces. Element tags: tet i is i+1, boundary triangle j is #tets + j + 1, so the order
 //!   survives the grouping into blocks.
 //!
+//! Ten-node tets ([`format_msh_quadratic`]): the same sections, the node block holding the
+//! corners and then the mid-edge nodes (tags 1..n in that order), the tets of type 11 with
+//! gmsh's node order (corners, then edges 01, 12, 20, 30, 32, 31: the gmsh manual's
+//! "Node ordering"), the boundary triangles of type 9 (corners, then edges 01, 12, 20).
+//!
 //! Read: ASCII 4.1 and 2.x (`$MeshFormat` 4.1 or 2.0-2.2, file type 0). 4.1: `$Entities`
 //! supplies the first physical tag of each surface and volume (0 when it has none or
 //! `$Entities` is absent); `$Nodes` blocks (parametric coordinates skipped); `$Elements`: tets
-//! (4) and triangles (2) are kept, sorted by element tag, other known element types are read
-//! past; nodes are ordered by tag. 2.x (still written by many tools): `$Nodes` as
-//! `<id> <x> <y> <z>`, `$Elements` as `<id> <type> <#tags> <physical> ...`; the first tag (the
-//! physical group) is the region or marker, 0 without tags. `$PhysicalNames` and any other
-//! section are skipped. Not supported: binary files, MSH 4.0, high-order tets (their elements
-//! are read past).
+//! (4) and triangles (2) are kept, and so are the corners of 10-node tets (11) and 6-node
+//! triangles (9), whose other nodes stay in the vertex list; all sorted by element tag; other
+//! known element types are read past; nodes are ordered by tag. 2.x (still written by many
+//! tools): `$Nodes` as `<id> <x> <y> <z>`, `$Elements` as `<id> <type> <#tags> <physical> ...`;
+//! the first tag (the physical group) is the region or marker, 0 without tags.
+//! `$PhysicalNames` and any other section are skipped. Not supported: binary files, MSH 4.0,
+//! tets of order 3 and more (their elements are read past).
 
+use super::elements::{Elements, GMSH_TET_ORDER, TRIANGLE_ORDER};
 use super::text::{
-    check_mesh, check_mesh_io, create, err_at, read_text, with_path, write_err, Tokens, F,
+    check_mesh, check_mesh_io, check_quadratic, check_quadratic_io, create, err_at, read_text,
+    with_path, write_err, write_int_line, Tokens, F,
 };
 use super::IoError;
-use crate::mesh::TetMesh;
+use crate::mesh::{QuadraticNodes, TetMesh};
 use glam::DVec3;
 use rustc_hash::FxHashMap;
 use std::io::Write;
@@ -42,6 +50,20 @@ pub fn write_msh(path: &Path, mesh: &TetMesh) -> Result<(), IoError> {
     check_mesh(mesh, &[]).map_err(|e| with_path(e, path))?;
     let mut w = create(path)?;
     format_msh(&mut w, mesh)
+        .and_then(|_| w.flush())
+        .map_err(|e| write_err(path, e))
+}
+
+/// Writes `mesh` with its mid-edge nodes as a gmsh 4.1 ASCII `.msh` file of ten-node tets.
+pub fn write_msh_quadratic(
+    path: &Path,
+    mesh: &TetMesh,
+    quadratic: &QuadraticNodes,
+) -> Result<(), IoError> {
+    check_mesh(mesh, &[]).map_err(|e| with_path(e, path))?;
+    check_quadratic(mesh, quadratic).map_err(|e| with_path(e, path))?;
+    let mut w = create(path)?;
+    format_msh_quadratic(&mut w, mesh, quadratic)
         .and_then(|_| w.flush())
         .map_err(|e| write_err(path, e))
 }
@@ -69,8 +91,9 @@ fn group(values: &[i32]) -> Vec<Entity> {
     out
 }
 
-/// Bounding box of the vertices of some elements (of all vertices when there are none).
-pub(super) fn bbox<const N: usize>(mesh: &TetMesh, elems: &[[u32; N]], ids: &[usize]) -> [f64; 6] {
+/// Bounding box of the nodes of some elements (tets when `tets`, else boundary triangles; of
+/// all nodes when there are none).
+pub(super) fn bbox(el: &Elements, tets: bool, ids: &[usize]) -> [f64; 6] {
     let mut lo = DVec3::splat(f64::INFINITY);
     let mut hi = DVec3::splat(f64::NEG_INFINITY);
     let mut add = |p: DVec3| {
@@ -78,17 +101,33 @@ pub(super) fn bbox<const N: usize>(mesh: &TetMesh, elems: &[[u32; N]], ids: &[us
         hi = hi.max(p);
     };
     if ids.is_empty() {
-        mesh.vertices.iter().for_each(|&p| add(p));
+        el.nodes().for_each(&mut add);
     }
     for &i in ids {
-        for &v in &elems[i] {
-            add(mesh.vertices[v as usize]);
+        if tets {
+            el.tet(i)[..el.tet_nodes()]
+                .iter()
+                .for_each(|&v| add(el.position(v)));
+        } else {
+            el.triangle(i)[..el.triangle_nodes()]
+                .iter()
+                .for_each(|&v| add(el.position(v)));
         }
     }
     if lo.x > hi.x {
         return [0.0; 6];
     }
     [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z]
+}
+
+/// Gmsh element types of the tets and the boundary triangles: 4 and 2, or 11 (10-node tet)
+/// and 9 (6-node triangle).
+pub(super) fn element_types(el: &Elements) -> (i32, i32) {
+    if el.is_quadratic() {
+        (11, 9)
+    } else {
+        (4, 2)
+    }
 }
 
 fn write_entity<W: Write>(w: &mut W, tag: usize, b: [f64; 6], value: i32) -> std::io::Result<()> {
@@ -138,17 +177,36 @@ pub(super) fn write_physical_names<W: Write>(
 /// An inconsistent mesh is an `InvalidInput` error.
 pub fn format_msh<W: Write>(w: &mut W, mesh: &TetMesh) -> std::io::Result<()> {
     check_mesh_io(mesh, &[])?;
-    let (nv, nt, nb) = (mesh.vertices.len(), mesh.tets.len(), mesh.boundary.len());
+    format_elements(w, &Elements::new(mesh, None))
+}
+
+/// Writes `mesh` with the mid-edge nodes `quadratic` as ten-node tets (type 11) and six-node
+/// boundary triangles (type 9) in gmsh 4.1 ASCII format; otherwise as [`format_msh`].
+/// An inconsistent mesh is an `InvalidInput` error.
+pub fn format_msh_quadratic<W: Write>(
+    w: &mut W,
+    mesh: &TetMesh,
+    quadratic: &QuadraticNodes,
+) -> std::io::Result<()> {
+    check_mesh_io(mesh, &[])?;
+    check_quadratic_io(mesh, quadratic)?;
+    format_elements(w, &Elements::new(mesh, Some(quadratic)))
+}
+
+fn format_elements<W: Write>(w: &mut W, el: &Elements) -> std::io::Result<()> {
+    let mesh = el.mesh;
+    let (nv, nt, nb) = (el.n_nodes(), mesh.tets.len(), mesh.boundary.len());
     let (volumes, surfaces) = entities(mesh);
+    let (tet_type, tri_type) = element_types(el);
     writeln!(w, "$MeshFormat\n4.1 0 8\n$EndMeshFormat")?;
     write_physical_names(w, &volumes, &surfaces)?;
 
     writeln!(w, "$Entities\n0 0 {} {}", surfaces.len(), volumes.len())?;
     for (k, e) in surfaces.iter().enumerate() {
-        write_entity(w, k + 1, bbox(mesh, &mesh.boundary, &e.elements), e.value)?;
+        write_entity(w, k + 1, bbox(el, false, &e.elements), e.value)?;
     }
     for (k, e) in volumes.iter().enumerate() {
-        write_entity(w, k + 1, bbox(mesh, &mesh.tets, &e.elements), e.value)?;
+        write_entity(w, k + 1, bbox(el, true, &e.elements), e.value)?;
     }
     writeln!(w, "$EndEntities")?;
 
@@ -160,7 +218,7 @@ pub fn format_msh<W: Write>(w: &mut W, mesh: &TetMesh) -> std::io::Result<()> {
         for i in 1..=nv {
             writeln!(w, "{i}")?;
         }
-        for p in &mesh.vertices {
+        for p in el.nodes() {
             writeln!(w, "{} {} {}", F(p.x), F(p.y), F(p.z))?;
         }
     }
@@ -174,29 +232,27 @@ pub fn format_msh<W: Write>(w: &mut W, mesh: &TetMesh) -> std::io::Result<()> {
     } else {
         writeln!(w, "{blocks} {ne} 1 {ne}")?;
     }
+    let mut line = Vec::new();
+    let mut ids: Vec<i64> = Vec::with_capacity(11);
     for (k, e) in volumes.iter().enumerate() {
         if e.elements.is_empty() {
             continue;
         }
-        writeln!(w, "3 {} 4 {}", k + 1, e.elements.len())?;
+        writeln!(w, "3 {} {tet_type} {}", k + 1, e.elements.len())?;
         for &i in &e.elements {
-            let t = mesh.tets[i];
-            writeln!(
-                w,
-                "{} {} {} {} {}",
-                i + 1,
-                t[0] + 1,
-                t[1] + 1,
-                t[2] + 1,
-                t[3] + 1
-            )?;
+            ids.clear();
+            ids.push(i as i64 + 1);
+            ids.extend(el.tet_in(i, &GMSH_TET_ORDER).map(|v| i64::from(v) + 1));
+            write_int_line(w, &mut line, &ids)?;
         }
     }
     for (k, e) in surfaces.iter().enumerate() {
-        writeln!(w, "2 {} 2 {}", k + 1, e.elements.len())?;
+        writeln!(w, "2 {} {tri_type} {}", k + 1, e.elements.len())?;
         for &j in &e.elements {
-            let t = mesh.boundary[j];
-            writeln!(w, "{} {} {} {}", nt + j + 1, t[0] + 1, t[1] + 1, t[2] + 1)?;
+            ids.clear();
+            ids.push((nt + j) as i64 + 1);
+            ids.extend(el.triangle_in(j, &TRIANGLE_ORDER).map(|v| i64::from(v) + 1));
+            write_int_line(w, &mut line, &ids)?;
         }
     }
     writeln!(w, "$EndElements")
@@ -387,8 +443,8 @@ pub fn parse_msh(text: &str) -> Result<TetMesh, IoError> {
                             *id = tok.raw_index("element node tag")?.1;
                         }
                         match ty {
-                            4 => tets.push((tag, l, [ids[0], ids[1], ids[2], ids[3]], entity)),
-                            2 => tris.push((tag, l, [ids[0], ids[1], ids[2]], entity)),
+                            4 | 11 => tets.push((tag, l, [ids[0], ids[1], ids[2], ids[3]], entity)),
+                            2 | 9 => tris.push((tag, l, [ids[0], ids[1], ids[2]], entity)),
                             _ => {}
                         }
                     }
@@ -489,11 +545,11 @@ fn parse_v2_elements(
         }
         let p = i64::from(physical);
         match ty {
-            4 => {
+            4 | 11 => {
                 vol.insert(p, physical);
                 tets.push((tag, l, [ids[0], ids[1], ids[2], ids[3]], (3, p)));
             }
-            2 => {
+            2 | 9 => {
                 surf.insert(p, physical);
                 tris.push((tag, l, [ids[0], ids[1], ids[2]], (2, p)));
             }

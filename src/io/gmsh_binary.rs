@@ -4,12 +4,16 @@
 //! node and element sections in the binary layout of the MSH 4.1 specification: `$MeshFormat`
 //! `4.1 1 8` and the int 1 (the reader's endianness check), then `int` as 4 and `size_t` as 8
 //! little-endian bytes, coordinates as 8-byte doubles. `$PhysicalNames` stays ASCII, as in
-//! gmsh's own binary files.
+//! gmsh's own binary files. Ten-node tets: [`format_msh_binary_quadratic`], the content of
+//! [`super::gmsh::format_msh_quadratic`].
 
-use super::gmsh::{entities, Entity};
-use super::text::{check_mesh, check_mesh_io, create, with_path, write_err};
+use super::elements::{Elements, GMSH_TET_ORDER, TRIANGLE_ORDER};
+use super::gmsh::{bbox, element_types, entities};
+use super::text::{
+    check_mesh, check_mesh_io, check_quadratic, check_quadratic_io, create, with_path, write_err,
+};
 use super::IoError;
-use crate::mesh::TetMesh;
+use crate::mesh::{QuadraticNodes, TetMesh};
 use std::io::Write;
 use std::path::Path;
 
@@ -18,6 +22,20 @@ pub fn write_msh_binary(path: &Path, mesh: &TetMesh) -> Result<(), IoError> {
     check_mesh(mesh, &[]).map_err(|e| with_path(e, path))?;
     let mut w = create(path)?;
     format_msh_binary(&mut w, mesh)
+        .and_then(|_| w.flush())
+        .map_err(|e| write_err(path, e))
+}
+
+/// Writes `mesh` with its mid-edge nodes as a gmsh 4.1 binary `.msh` file of ten-node tets.
+pub fn write_msh_binary_quadratic(
+    path: &Path,
+    mesh: &TetMesh,
+    quadratic: &QuadraticNodes,
+) -> Result<(), IoError> {
+    check_mesh(mesh, &[]).map_err(|e| with_path(e, path))?;
+    check_quadratic(mesh, quadratic).map_err(|e| with_path(e, path))?;
+    let mut w = create(path)?;
+    format_msh_binary_quadratic(&mut w, mesh, quadratic)
         .and_then(|_| w.flush())
         .map_err(|e| write_err(path, e))
 }
@@ -49,8 +67,27 @@ fn entity<W: Write>(w: &mut W, tag: usize, b: [f64; 6], value: i32) -> std::io::
 /// An inconsistent mesh is an `InvalidInput` error.
 pub fn format_msh_binary<W: Write>(w: &mut W, mesh: &TetMesh) -> std::io::Result<()> {
     check_mesh_io(mesh, &[])?;
-    let (nv, nt, nb) = (mesh.vertices.len(), mesh.tets.len(), mesh.boundary.len());
+    format_elements(w, &Elements::new(mesh, None))
+}
+
+/// [`format_msh_binary`] of ten-node tets (type 11) and six-node boundary triangles (type 9),
+/// node order as in [`super::gmsh::format_msh_quadratic`].
+/// An inconsistent mesh is an `InvalidInput` error.
+pub fn format_msh_binary_quadratic<W: Write>(
+    w: &mut W,
+    mesh: &TetMesh,
+    quadratic: &QuadraticNodes,
+) -> std::io::Result<()> {
+    check_mesh_io(mesh, &[])?;
+    check_quadratic_io(mesh, quadratic)?;
+    format_elements(w, &Elements::new(mesh, Some(quadratic)))
+}
+
+fn format_elements<W: Write>(w: &mut W, el: &Elements) -> std::io::Result<()> {
+    let mesh = el.mesh;
+    let (nv, nt, nb) = (el.n_nodes(), mesh.tets.len(), mesh.boundary.len());
     let (volumes, surfaces) = entities(mesh);
+    let (tet_type, tri_type) = element_types(el);
     w.write_all(b"$MeshFormat\n4.1 1 8\n")?;
     int(w, 1)?;
     w.write_all(b"\n$EndMeshFormat\n")?;
@@ -60,23 +97,11 @@ pub fn format_msh_binary<W: Write>(w: &mut W, mesh: &TetMesh) -> std::io::Result
     for n in [0, 0, surfaces.len(), volumes.len()] {
         size(w, n)?;
     }
-    let boxes = |elems: &[Entity], tets: bool| -> Vec<[f64; 6]> {
-        elems
-            .iter()
-            .map(|e| {
-                if tets {
-                    super::gmsh::bbox(mesh, &mesh.tets, &e.elements)
-                } else {
-                    super::gmsh::bbox(mesh, &mesh.boundary, &e.elements)
-                }
-            })
-            .collect()
-    };
-    for (k, (e, b)) in surfaces.iter().zip(boxes(&surfaces, false)).enumerate() {
-        entity(w, k + 1, b, e.value)?;
+    for (k, e) in surfaces.iter().enumerate() {
+        entity(w, k + 1, bbox(el, false, &e.elements), e.value)?;
     }
-    for (k, (e, b)) in volumes.iter().zip(boxes(&volumes, true)).enumerate() {
-        entity(w, k + 1, b, e.value)?;
+    for (k, e) in volumes.iter().enumerate() {
+        entity(w, k + 1, bbox(el, true, &e.elements), e.value)?;
     }
     w.write_all(b"\n$EndEntities\n")?;
 
@@ -96,7 +121,7 @@ pub fn format_msh_binary<W: Write>(w: &mut W, mesh: &TetMesh) -> std::io::Result
         for i in 1..=nv {
             size(w, i)?;
         }
-        for p in &mesh.vertices {
+        for p in el.nodes() {
             for x in p.to_array() {
                 double(w, x)?;
             }
@@ -120,25 +145,25 @@ pub fn format_msh_binary<W: Write>(w: &mut W, mesh: &TetMesh) -> std::io::Result
         if e.elements.is_empty() {
             continue;
         }
-        for v in [3, k as i32 + 1, 4] {
+        for v in [3, k as i32 + 1, tet_type] {
             int(w, v)?;
         }
         size(w, e.elements.len())?;
         for &i in &e.elements {
             size(w, i + 1)?;
-            for v in mesh.tets[i] {
+            for v in el.tet_in(i, &GMSH_TET_ORDER) {
                 size(w, v as usize + 1)?;
             }
         }
     }
     for (k, e) in surfaces.iter().enumerate() {
-        for v in [2, k as i32 + 1, 2] {
+        for v in [2, k as i32 + 1, tri_type] {
             int(w, v)?;
         }
         size(w, e.elements.len())?;
         for &j in &e.elements {
             size(w, nt + j + 1)?;
-            for v in mesh.boundary[j] {
+            for v in el.triangle_in(j, &TRIANGLE_ORDER) {
                 size(w, v as usize + 1)?;
             }
         }

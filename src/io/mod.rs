@@ -14,6 +14,10 @@
 //! | gmsh `.msh` 4.1 (read: also 2.x) | mesh | mesh | [`gmsh`] |
 //! | TetGen `.node`/`.ele`/`.face` | mesh | mesh | [`tetgen`] |
 //!
+//! Every mesh writer also writes ten-node tets ([`write_output`] with
+//! [`QuadraticNodes`]): the element names and node order of each format are in
+//! docs/formats.md.
+//!
 //! [`read_plc`], [`read_mesh`] and [`write_mesh`] choose the format by extension
 //! (case-insensitive). Errors are [`IoError`]s naming the file and, for text formats, the
 //! 1-based line. Floats are written in shortest round-trip form, so a written mesh reads back
@@ -27,6 +31,7 @@ use std::path::Path;
 
 pub use crate::plc::coplanar;
 pub mod abaqus;
+mod elements;
 pub mod gmsh;
 pub mod gmsh_binary;
 pub mod medit;
@@ -174,6 +179,14 @@ pub fn write_mesh_in(
 
 /// [`write_mesh_in`] for a mesh of ten-node tets when `quadratic` is given (`--order 2`),
 /// else of four-node tets. Node order per format: docs/formats.md.
+///
+/// With `quadratic`: gmsh `.msh` (ASCII or, with `binary`, binary) of 10-node tets (type 11)
+/// and 6-node triangles (type 9); `.vtu` (ASCII or binary appended) of `VTK_QUADRATIC_TETRA`;
+/// medit `.mesh` with `TetrahedraP2` and `TrianglesP2`; Abaqus `.inp` of C3D10; TetGen
+/// `.node/.ele/.face` as `tetgen -o2` writes them. Every format lists the corners first, then
+/// the mid-edge nodes (node `mesh.vertices.len() + k` is `quadratic.points[k]`); regions and
+/// boundary markers go where the four-node writers put them. A `quadratic` that does not fit
+/// `mesh` (list counts, node ids) is an error naming the mismatch.
 pub fn write_output(
     path: &Path,
     mesh: &TetMesh,
@@ -181,13 +194,24 @@ pub fn write_output(
     cell_fields: &[CellField],
     binary: bool,
 ) -> Result<(), IoError> {
-    match quadratic {
-        None => write_mesh_in(path, mesh, cell_fields, binary),
-        Some(_) => Err(IoError {
-            path: path.display().to_string(),
-            line: None,
-            message: "ten-node tets are not written yet".into(),
-        }),
+    let Some(q) = quadratic else {
+        return write_mesh_in(path, mesh, cell_fields, binary);
+    };
+    let ext = extension(path, WRITE_EXTENSIONS, "mesh")?;
+    let lens: Vec<(&str, usize)> = cell_fields
+        .iter()
+        .map(|f| (f.name, f.values.len()))
+        .collect();
+    text::check_mesh(mesh, &lens).map_err(|e| text::with_path(e, path))?;
+    text::check_quadratic(mesh, q).map_err(|e| text::with_path(e, path))?;
+    match ext.as_str() {
+        "vtu" if binary => vtu_binary::write_vtu_binary_quadratic(path, mesh, q, cell_fields),
+        "vtu" => vtu::write_vtu_quadratic(path, mesh, q, cell_fields),
+        "msh" if binary => gmsh_binary::write_msh_binary_quadratic(path, mesh, q),
+        "msh" => gmsh::write_msh_quadratic(path, mesh, q),
+        "mesh" => medit::write_medit_quadratic(path, mesh, q),
+        "inp" => abaqus::write_inp_quadratic(path, mesh, q),
+        _ => tetgen::write_tetgen_quadratic(path, mesh, q),
     }
 }
 

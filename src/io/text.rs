@@ -6,7 +6,7 @@
 //! [`with_path`] so that parse functions can also be tested on in-memory strings.
 
 use super::IoError;
-use crate::mesh::TetMesh;
+use crate::mesh::{QuadraticNodes, TetMesh};
 use glam::DVec3;
 use std::borrow::Cow;
 use std::fmt;
@@ -502,6 +502,58 @@ pub(crate) fn write_float_line(
 pub(crate) fn check_mesh_io(mesh: &TetMesh, field_lens: &[(&str, usize)]) -> std::io::Result<()> {
     check_mesh(mesh, field_lens)
         .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidInput, e.message))
+}
+
+/// [`check_quadratic`] for the `format_*` functions, which return `std::io::Error`.
+pub(crate) fn check_quadratic_io(mesh: &TetMesh, q: &QuadraticNodes) -> std::io::Result<()> {
+    check_quadratic(mesh, q)
+        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidInput, e.message))
+}
+
+/// Checks that the mid-edge nodes `q` belong to `mesh` (one edge-node list per tet and per
+/// boundary triangle, every id below the node count), so writers of ten-node tets never index
+/// out of range.
+pub(crate) fn check_quadratic(mesh: &TetMesh, q: &QuadraticNodes) -> Result<(), IoError> {
+    let bad = |m: String| err_file(format!("cannot write inconsistent ten-node tets: {m}"));
+    if q.tet_edges.len() != mesh.tets.len() {
+        return Err(bad(format!(
+            "{} tets but {} lists of mid-edge nodes",
+            mesh.tets.len(),
+            q.tet_edges.len()
+        )));
+    }
+    if q.boundary_edges.len() != mesh.boundary.len() {
+        return Err(bad(format!(
+            "{} boundary triangles but {} lists of mid-edge nodes",
+            mesh.boundary.len(),
+            q.boundary_edges.len()
+        )));
+    }
+    let n = q.n_nodes(mesh);
+    if u32::try_from(n).is_err() {
+        return Err(bad(format!("{n} nodes exceed the 32-bit id range")));
+    }
+    if let Some((i, e)) = q
+        .tet_edges
+        .iter()
+        .enumerate()
+        .find(|(_, e)| e.iter().any(|&v| v as usize >= n))
+    {
+        return Err(bad(format!(
+            "tet {i}'s mid-edge nodes {e:?} refer to a node beyond the {n} nodes"
+        )));
+    }
+    if let Some((i, e)) = q
+        .boundary_edges
+        .iter()
+        .enumerate()
+        .find(|(_, e)| e.iter().any(|&v| v as usize >= n))
+    {
+        return Err(bad(format!(
+            "boundary triangle {i}'s mid-edge nodes {e:?} refer to a node beyond the {n} nodes"
+        )));
+    }
+    Ok(())
 }
 
 /// Checks that a mesh is self-consistent before writing it, so writers never index out of range.

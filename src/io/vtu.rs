@@ -10,32 +10,48 @@
 //! `nan` and `inf`, but it reads `-inf` as `inf`, and older VTK ASCII parsers may reject such
 //! an array.
 //! Boundary triangles are not written (a `.vtu` holds the tets only: use `.mesh` or `.msh` to
-//! keep boundary markers).
+//! keep boundary markers). Ten-node tets ([`format_vtu_quadratic`]): the points are the corners
+//! and then the mid-edge nodes, the cells `VTK_QUADRATIC_TETRA` (24) with the corners and the
+//! edges ab, bc, ac, ad, bd, cd (VTK's order, the mesh's own); the cell data is the same.
 //!
 //! Read: ASCII `DataArray`s only (no `binary`/`appended`/compressed data), one `Piece`, cells of
 //! type 10 only; `Points`, `connectivity`, `offsets`, `types`, the `region` cell array (tets get
 //! region 0 when it is absent) and every other `CellData` array as a named field. Point data is
 //! ignored. Errors carry the line of the offending array.
 
+use super::elements::Elements;
 use super::text::{
-    check_mesh, check_mesh_io, create, err_at, err_file, float_text, parse_f64, read_text, to_u32,
-    with_path, write_err, write_float_line, write_int_line, write_line,
+    check_mesh, check_mesh_io, check_quadratic, check_quadratic_io, create, err_at, err_file,
+    float_text, parse_f64, read_text, to_u32, with_path, write_err, write_float_line,
+    write_int_line, write_line,
 };
 use super::{CellField, IoError};
-use crate::mesh::TetMesh;
+use crate::mesh::{QuadraticNodes, TetMesh};
 use glam::DVec3;
 use std::io::Write;
 use std::path::Path;
 
 /// Writes `mesh` with `cell_fields` as a `.vtu` file.
 pub fn write_vtu(path: &Path, mesh: &TetMesh, cell_fields: &[CellField]) -> Result<(), IoError> {
-    let lens: Vec<(&str, usize)> = cell_fields
-        .iter()
-        .map(|f| (f.name, f.values.len()))
-        .collect();
-    check_mesh(mesh, &lens).map_err(|e| with_path(e, path))?;
+    check_mesh(mesh, &field_lens(cell_fields)).map_err(|e| with_path(e, path))?;
     let mut w = create(path)?;
     format_vtu(&mut w, mesh, cell_fields)
+        .and_then(|_| w.flush())
+        .map_err(|e| write_err(path, e))
+}
+
+/// Writes `mesh` with its mid-edge nodes and `cell_fields` as a `.vtu` file of
+/// `VTK_QUADRATIC_TETRA` cells.
+pub fn write_vtu_quadratic(
+    path: &Path,
+    mesh: &TetMesh,
+    quadratic: &QuadraticNodes,
+    cell_fields: &[CellField],
+) -> Result<(), IoError> {
+    check_mesh(mesh, &field_lens(cell_fields)).map_err(|e| with_path(e, path))?;
+    check_quadratic(mesh, quadratic).map_err(|e| with_path(e, path))?;
+    let mut w = create(path)?;
+    format_vtu_quadratic(&mut w, mesh, quadratic, cell_fields)
         .and_then(|_| w.flush())
         .map_err(|e| write_err(path, e))
 }
@@ -75,19 +91,14 @@ fn push_int(line: &mut Vec<u8>, x: impl itoa::Integer) {
     line.extend_from_slice(itoa::Buffer::new().format(x).as_bytes());
 }
 
-/// Writes `mesh` in `.vtu` format to any writer.
-/// An inconsistent mesh is an `InvalidInput` error.
-pub fn format_vtu<W: Write>(
+/// The document up to the first `DataArray`: XML declaration, `VTKFile` (version 1.0, little
+/// endian, `UInt64` headers), `UnstructuredGrid`, the one `Piece` and `<Points>`. Shared by the
+/// ASCII and the binary appended writers.
+pub(super) fn write_prologue<W: Write>(
     w: &mut W,
-    mesh: &TetMesh,
-    cell_fields: &[CellField],
+    n_points: usize,
+    n_cells: usize,
 ) -> std::io::Result<()> {
-    let lens: Vec<(&str, usize)> = cell_fields
-        .iter()
-        .map(|f| (f.name, f.values.len()))
-        .collect();
-    check_mesh_io(mesh, &lens)?;
-    let (nv, nt) = (mesh.vertices.len(), mesh.tets.len());
     writeln!(w, "<?xml version=\"1.0\"?>")?;
     writeln!(
         w,
@@ -95,14 +106,72 @@ pub fn format_vtu<W: Write>(
          header_type=\"UInt64\">"
     )?;
     writeln!(w, "<UnstructuredGrid>")?;
-    writeln!(w, "<Piece NumberOfPoints=\"{nv}\" NumberOfCells=\"{nt}\">")?;
-    writeln!(w, "<Points>")?;
+    writeln!(
+        w,
+        "<Piece NumberOfPoints=\"{n_points}\" NumberOfCells=\"{n_cells}\">"
+    )?;
+    writeln!(w, "<Points>")
+}
+
+/// The VTK cell type of the tets and its node count: `VTK_TETRA` (10) with 4 nodes, or
+/// `VTK_QUADRATIC_TETRA` (24) with 10 (corners, then edges ab, bc, ac, ad, bd, cd: the mesh's
+/// own order).
+pub(super) fn cell_type(el: &Elements) -> (u8, usize) {
+    if el.is_quadratic() {
+        (24, 10)
+    } else {
+        (10, 4)
+    }
+}
+
+/// Writes `mesh` in `.vtu` format to any writer.
+/// An inconsistent mesh is an `InvalidInput` error.
+pub fn format_vtu<W: Write>(
+    w: &mut W,
+    mesh: &TetMesh,
+    cell_fields: &[CellField],
+) -> std::io::Result<()> {
+    check_mesh_io(mesh, &field_lens(cell_fields))?;
+    format_elements(w, &Elements::new(mesh, None), cell_fields)
+}
+
+/// Writes `mesh` with its mid-edge nodes as `VTK_QUADRATIC_TETRA` cells in `.vtu` format:
+/// the points are the corners and then the mid-edge nodes, the cell data as in [`format_vtu`].
+/// An inconsistent mesh is an `InvalidInput` error.
+pub fn format_vtu_quadratic<W: Write>(
+    w: &mut W,
+    mesh: &TetMesh,
+    quadratic: &QuadraticNodes,
+    cell_fields: &[CellField],
+) -> std::io::Result<()> {
+    check_mesh_io(mesh, &field_lens(cell_fields))?;
+    check_quadratic_io(mesh, quadratic)?;
+    format_elements(w, &Elements::new(mesh, Some(quadratic)), cell_fields)
+}
+
+/// The (name, length) of each cell field, for the mesh checks.
+pub(super) fn field_lens<'a>(cell_fields: &[CellField<'a>]) -> Vec<(&'a str, usize)> {
+    cell_fields
+        .iter()
+        .map(|f| (f.name, f.values.len()))
+        .collect()
+}
+
+fn format_elements<W: Write>(
+    w: &mut W,
+    el: &Elements,
+    cell_fields: &[CellField],
+) -> std::io::Result<()> {
+    let mesh = el.mesh;
+    let nt = mesh.tets.len();
+    let (ty, k) = cell_type(el);
+    write_prologue(w, el.n_nodes(), nt)?;
     writeln!(
         w,
         "<DataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\" format=\"ascii\">"
     )?;
     let mut line = Vec::new();
-    for p in &mesh.vertices {
+    for p in el.nodes() {
         write_float_line(w, &mut line, &p.to_array())?;
     }
     writeln!(w, "</DataArray>\n</Points>\n<Cells>")?;
@@ -110,22 +179,23 @@ pub fn format_vtu<W: Write>(
         w,
         "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">"
     )?;
-    for t in &mesh.tets {
-        write_int_line(w, &mut line, &t.map(i64::from))?;
+    for i in 0..nt {
+        let t = el.tet(i).map(i64::from);
+        write_int_line(w, &mut line, &t[..k])?;
     }
     writeln!(w, "</DataArray>")?;
     writeln!(
         w,
         "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">"
     )?;
-    let offsets: Vec<usize> = (1..=nt).map(|i| 4 * i).collect();
+    let offsets: Vec<usize> = (1..=nt).map(|i| k * i).collect();
     write_rows(w, &offsets, 16, push_int)?;
     writeln!(w, "</DataArray>")?;
     writeln!(
         w,
         "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">"
     )?;
-    let types = vec![10u8; nt];
+    let types = vec![ty; nt];
     write_rows(w, &types, 32, push_int)?;
     writeln!(w, "</DataArray>\n</Cells>")?;
     writeln!(w, "<CellData Scalars=\"region\">")?;

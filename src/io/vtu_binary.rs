@@ -3,12 +3,17 @@
 //! each `format="appended"` with its `offset` into one `<AppendedData encoding="raw">` block,
 //! where it is stored as a `UInt64` byte count followed by its little-endian values
 //! (`header_type="UInt64"`). About a third of the ASCII file's size, and no number formatting.
-//! This module's reader does not read it back (`super::vtu` reads ASCII arrays only); VTK does
-//! (the ctest `vtk_readback_binary_*`).
+//! Ten-node tets: [`format_vtu_binary_quadratic`], the arrays of
+//! [`super::vtu::format_vtu_quadratic`]. This module's reader does not read it back
+//! (`super::vtu` reads ASCII arrays only); VTK does (the ctest `vtk_readback_binary_*`).
 
-use super::text::{check_mesh, check_mesh_io, create, with_path, write_err};
+use super::elements::Elements;
+use super::text::{
+    check_mesh, check_mesh_io, check_quadratic, check_quadratic_io, create, with_path, write_err,
+};
+use super::vtu::{cell_type, field_lens, write_prologue};
 use super::{CellField, IoError};
-use crate::mesh::TetMesh;
+use crate::mesh::{QuadraticNodes, TetMesh};
 use std::io::Write;
 use std::path::Path;
 
@@ -18,13 +23,25 @@ pub fn write_vtu_binary(
     mesh: &TetMesh,
     cell_fields: &[CellField],
 ) -> Result<(), IoError> {
-    let lens: Vec<(&str, usize)> = cell_fields
-        .iter()
-        .map(|f| (f.name, f.values.len()))
-        .collect();
-    check_mesh(mesh, &lens).map_err(|e| with_path(e, path))?;
+    check_mesh(mesh, &field_lens(cell_fields)).map_err(|e| with_path(e, path))?;
     let mut w = create(path)?;
     format_vtu_binary(&mut w, mesh, cell_fields)
+        .and_then(|_| w.flush())
+        .map_err(|e| write_err(path, e))
+}
+
+/// Writes `mesh` with its mid-edge nodes and `cell_fields` as a binary appended `.vtu` file of
+/// `VTK_QUADRATIC_TETRA` cells (the arrays of [`super::vtu::format_vtu_quadratic`]).
+pub fn write_vtu_binary_quadratic(
+    path: &Path,
+    mesh: &TetMesh,
+    quadratic: &QuadraticNodes,
+    cell_fields: &[CellField],
+) -> Result<(), IoError> {
+    check_mesh(mesh, &field_lens(cell_fields)).map_err(|e| with_path(e, path))?;
+    check_quadratic(mesh, quadratic).map_err(|e| with_path(e, path))?;
+    let mut w = create(path)?;
+    format_vtu_binary_quadratic(&mut w, mesh, quadratic, cell_fields)
         .and_then(|_| w.flush())
         .map_err(|e| write_err(path, e))
 }
@@ -36,24 +53,44 @@ struct Array {
 }
 
 /// Writes `mesh` in the binary appended `.vtu` form to any writer.
+/// An inconsistent mesh is an `InvalidInput` error.
 pub fn format_vtu_binary<W: Write>(
     w: &mut W,
     mesh: &TetMesh,
     cell_fields: &[CellField],
 ) -> std::io::Result<()> {
-    let lens: Vec<(&str, usize)> = cell_fields
-        .iter()
-        .map(|f| (f.name, f.values.len()))
-        .collect();
-    check_mesh_io(mesh, &lens)?;
-    let (nv, nt) = (mesh.vertices.len(), mesh.tets.len());
+    check_mesh_io(mesh, &field_lens(cell_fields))?;
+    format_elements(w, &Elements::new(mesh, None), cell_fields)
+}
+
+/// [`format_vtu_binary`] of ten-node tets (`VTK_QUADRATIC_TETRA`).
+/// An inconsistent mesh is an `InvalidInput` error.
+pub fn format_vtu_binary_quadratic<W: Write>(
+    w: &mut W,
+    mesh: &TetMesh,
+    quadratic: &QuadraticNodes,
+    cell_fields: &[CellField],
+) -> std::io::Result<()> {
+    check_mesh_io(mesh, &field_lens(cell_fields))?;
+    check_quadratic_io(mesh, quadratic)?;
+    format_elements(w, &Elements::new(mesh, Some(quadratic)), cell_fields)
+}
+
+fn format_elements<W: Write>(
+    w: &mut W,
+    el: &Elements,
+    cell_fields: &[CellField],
+) -> std::io::Result<()> {
+    let mesh = el.mesh;
+    let (nv, nt) = (el.n_nodes(), mesh.tets.len());
+    let (ty, k) = cell_type(el);
     let array = |attributes: String, bytes: usize| Array { attributes, bytes };
     let points = array(
         "type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\"".into(),
         24 * nv,
     );
     let cells = [
-        array("type=\"Int64\" Name=\"connectivity\"".into(), 32 * nt),
+        array("type=\"Int64\" Name=\"connectivity\"".into(), 8 * k * nt),
         array("type=\"Int64\" Name=\"offsets\"".into(), 8 * nt),
         array("type=\"UInt8\" Name=\"types\"".into(), nt),
     ];
@@ -77,15 +114,7 @@ pub fn format_vtu_binary<W: Write>(
         offset += 8 + a.bytes;
         Ok(())
     };
-    writeln!(w, "<?xml version=\"1.0\"?>")?;
-    writeln!(
-        w,
-        "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" \
-         header_type=\"UInt64\">"
-    )?;
-    writeln!(w, "<UnstructuredGrid>")?;
-    writeln!(w, "<Piece NumberOfPoints=\"{nv}\" NumberOfCells=\"{nt}\">")?;
-    writeln!(w, "<Points>")?;
+    write_prologue(w, nv, nt)?;
     tag(w, &points)?;
     writeln!(w, "</Points>\n<Cells>")?;
     for a in &cells {
@@ -99,23 +128,23 @@ pub fn format_vtu_binary<W: Write>(
     w.write_all(b"<AppendedData encoding=\"raw\">\n_")?;
     let header = |w: &mut W, bytes: usize| w.write_all(&(bytes as u64).to_le_bytes());
     header(w, points.bytes)?;
-    for p in &mesh.vertices {
+    for p in el.nodes() {
         for x in p.to_array() {
             w.write_all(&x.to_le_bytes())?;
         }
     }
     header(w, cells[0].bytes)?;
-    for t in &mesh.tets {
-        for v in t {
-            w.write_all(&i64::from(*v).to_le_bytes())?;
+    for i in 0..nt {
+        for &v in &el.tet(i)[..k] {
+            w.write_all(&i64::from(v).to_le_bytes())?;
         }
     }
     header(w, cells[1].bytes)?;
     for i in 1..=nt {
-        w.write_all(&(4 * i as i64).to_le_bytes())?;
+        w.write_all(&((k * i) as i64).to_le_bytes())?;
     }
     header(w, cells[2].bytes)?;
-    w.write_all(&vec![10u8; nt])?;
+    w.write_all(&vec![ty; nt])?;
     header(w, cell_data[0].bytes)?;
     for r in &mesh.tet_regions {
         w.write_all(&r.to_le_bytes())?;

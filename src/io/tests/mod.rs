@@ -3,6 +3,7 @@
 
 mod fuzz;
 mod models;
+mod quadratic;
 mod roundtrip;
 mod surface;
 
