@@ -104,6 +104,13 @@ int main(int argc, char** argv) {
     return 1;
   }
 
+  // With --order 2 the report names the mid-edge nodes: the points are the vertices and those,
+  // the cells VTK_QUADRATIC_TETRA (corners first, as the linear tet).
+  double n_edge_nodes = 0;
+  const bool quadratic = json_number(stats, "n_edge_nodes", &n_edge_nodes);
+  const int want_type = quadratic ? VTK_QUADRATIC_TETRA : VTK_TETRA;
+  const std::string want_name = quadratic ? "VTK_QUADRATIC_TETRA (24)" : "VTK_TETRA (10)";
+
   if (!std::ifstream(vtu)) usage("cannot open " + vtu);
   vtkNew<vtkXMLUnstructuredGridReader> reader;
   reader->SetFileName(vtu.c_str());
@@ -112,8 +119,9 @@ int main(int argc, char** argv) {
   const vtkIdType np = ug ? ug->GetNumberOfPoints() : 0, nc = ug ? ug->GetNumberOfCells() : 0;
   std::printf("%s: %lld points, %lld cells (report: %.0f vertices, %.0f tets)\n", vtu.c_str(),
               static_cast<long long>(np), static_cast<long long>(nc), n_vertices, n_tets);
-  if (np != static_cast<vtkIdType>(n_vertices))
-    fail("VTK read " + std::to_string(np) + " points, the report says " + fmt(n_vertices));
+  if (np != static_cast<vtkIdType>(n_vertices + n_edge_nodes))
+    fail("VTK read " + std::to_string(np) + " points, the report says " +
+         fmt(n_vertices + n_edge_nodes));
   if (nc != static_cast<vtkIdType>(n_tets))
     fail("VTK read " + std::to_string(nc) + " cells, the report says " + fmt(n_tets));
   if (nc == 0) {
@@ -150,10 +158,10 @@ int main(int argc, char** argv) {
   std::set<int> regions;
   vtkNew<vtkIdList> ids;
   for (vtkIdType c = 0; c < nc; ++c) {
-    if (ug->GetCellType(c) != VTK_TETRA) {
+    if (ug->GetCellType(c) != want_type) {
       if (not_tetra++ < show)
         fail("cell " + std::to_string(c) + " has VTK type " + std::to_string(ug->GetCellType(c)) +
-             ", not VTK_TETRA (10)");
+             ", not " + want_name);
       continue;
     }
     ug->GetCellPoints(c, ids);
@@ -190,7 +198,7 @@ int main(int argc, char** argv) {
   auto count = [&](std::size_t n, const char* what) {
     if (n > show) fail(std::to_string(n) + " cells in all " + what);
   };
-  count(not_tetra, "are not VTK_TETRA");
+  count(not_tetra, ("are not " + want_name).c_str());
   count(not_positive, "have volume <= 0");
   count(rho_off, "disagree on radius_edge_ratio");
   count(sigma_off, "disagree on sigma");
