@@ -18,6 +18,7 @@ pub mod report;
 mod spacing;
 
 pub use outcome::Refusals;
+pub use quality::SPACING_BATCH;
 pub use spacing::AutoSpacing;
 
 use crate::mesh::TetMesh;
