@@ -403,6 +403,18 @@ sm_status sm_set_spacing_cb(sm_mesher *m, sm_spacing_fn f, void *user_data);
 sm_status sm_set_spacing_batch_cb(sm_mesher *m, sm_spacing_batch_fn f, void *user_data);
 
 /**
+ * Limits the spacing in the region of attribute `id` to at most `h` (finite, > 0;
+ * `SM_ERR_INVALID_ARGUMENT` otherwise): its tets get the smaller of `h` and the spacing there
+ * (CLI `--region-size ID:H`). Again for the same `id`, the new `h` replaces the old. An `id`
+ * the input has no region of makes `sm_refine` fail with `SM_ERR_INVALID_INPUT`, the message
+ * naming it and listing the input's regions.
+ *
+ * # Safety
+ * `m` is NULL or a live handle.
+ */
+sm_status sm_set_region_size(sm_mesher *m, int32_t id, double h);
+
+/**
  * Uses a size field on a background tet mesh as the spacing (adaptive loops: the field computed
  * on the previous mesh): `n_vertices` points `xyz` (3 doubles each), `n_tets` tets `tets` (4
  * 0-based vertex ids each) and one value per vertex (finite, > 0). The spacing at a point is the

@@ -219,6 +219,8 @@ pub struct SurfaceMesher<'a> {
     thin: Option<ThinBound>,
     /// Samples a repaired input's boundary was mended at (`rounds`), by coordinate bits.
     mended: FxHashSet<[u64; 3]>,
+    /// Per region number the most spacing its cells get (`Params::region_sizes`; empty: none).
+    region_caps: Vec<f64>,
 }
 
 /// The surface spacing's bound by the input's thickness, per input triangle.
@@ -316,6 +318,7 @@ impl<'a> SurfaceMesher<'a> {
             vol: None,
             input_samples: std::cell::OnceCell::new(),
             mended: FxHashSet::default(),
+            region_caps: vec![],
             thin: thickness.map(|t| ThinBound {
                 per_triangle: t.per_triangle(surface),
                 scale: criteria.thickness_spacing,
@@ -352,6 +355,11 @@ impl<'a> SurfaceMesher<'a> {
         };
         m.start_tracking();
         Ok(m)
+    }
+
+    /// Caps the cells' spacing per region number (see `approx::region_caps`).
+    pub fn set_region_caps(&mut self, caps: Vec<f64>) {
+        self.region_caps = caps;
     }
 
     /// The surface spacing at `p`: the caller's, bounded by the thickness of the input

@@ -145,6 +145,24 @@ pub unsafe extern "C" fn sm_set_spacing_batch_cb(
     })
 }
 
+/// Limits the spacing in the region of attribute `id` to at most `h` (finite, > 0;
+/// `SM_ERR_INVALID_ARGUMENT` otherwise): its tets get the smaller of `h` and the spacing there
+/// (CLI `--region-size ID:H`). Again for the same `id`, the new `h` replaces the old. An `id`
+/// the input has no region of makes `sm_refine` fail with `SM_ERR_INVALID_INPUT`, the message
+/// naming it and listing the input's regions.
+///
+/// # Safety
+/// `m` is NULL or a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn sm_set_region_size(m: *mut sm_mesher, id: i32, h: f64) -> sm_status {
+    // SAFETY: `m` is NULL or a live handle (contract above).
+    let handle = unsafe { m.as_ref() };
+    handle_call(handle, "sm_set_region_size", |st| {
+        st.mesher.set_region_size(id, h)?;
+        Ok(())
+    })
+}
+
 /// Uses a size field on a background tet mesh as the spacing (adaptive loops: the field computed
 /// on the previous mesh): `n_vertices` points `xyz` (3 doubles each), `n_tets` tets `tets` (4
 /// 0-based vertex ids each) and one value per vertex (finite, > 0). The spacing at a point is the

@@ -268,6 +268,10 @@ impl SurfaceMesher<'_> {
     /// The rest of [`Self::cell_class`], given `f` at the circumcentre (radius `r`).
     fn finish_cell(&self, t: u32, r: f64, f: f64) -> Option<usize> {
         let vol = self.vol.as_ref()?;
+        let f = match self.region_caps.get(self.region_of(t) as usize) {
+            Some(&cap) => f.min(cap),
+            None => f,
+        };
         if r > vol.crit.size_factor * f {
             return Some(SIZE);
         }
