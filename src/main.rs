@@ -36,6 +36,8 @@ struct Cli {
     command: Option<Command>,
 }
 
+// `Mesh` holds every mesh option; the value is parsed once per run, so its size does not matter.
+#[allow(clippy::large_enum_variant)]
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Delaunay-tetrahedralize a point file (one `x y z` per line, `#` comments).

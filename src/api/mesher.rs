@@ -241,6 +241,24 @@ impl Mesher {
         self.changed()
     }
 
+    /// Limits the spacing in the region of attribute `id` to at most `h` (finite, > 0): its tets
+    /// get the smaller of `h` and the spacing there (CLI `--region-size ID:H`). Given again
+    /// for the same id, the new `h` replaces the old. An id the input has no region of fails
+    /// [`Mesher::refine`], naming the id and listing the input's regions.
+    pub fn set_region_size(&mut self, id: i32, h: f64) -> Result<&mut Self, Error> {
+        if !valid_value(h) {
+            return invalid(format!(
+                "region size for region {id}: h = {h} must be finite and > 0"
+            ));
+        }
+        let sizes = &mut self.params.region_sizes;
+        match sizes.iter_mut().find(|(i, _)| *i == id) {
+            Some(entry) => entry.1 = h,
+            None => sizes.push((id, h)),
+        }
+        Ok(self.changed())
+    }
+
     /// Called with (fraction done, vertex count), once with 0 before any work and then as the
     /// refiner reports; returning `false` cancels the run ([`MeshError::Cancelled`]).
     pub fn set_progress<F: FnMut(f64, usize) -> bool + Send + 'static>(

@@ -61,15 +61,18 @@ impl<'a> Checked<'a> {
             .map(|(point, value)| MeshError::BadSpacing { point, value })
     }
 
-    /// Evaluates the spacing at `points` in one batch and fails on the first bad value: run on
-    /// the input vertices before meshing, so a broken callback is reported at once, naming the
-    /// point, instead of after boundary recovery.
+    /// Evaluates the spacing at `points` in batches of at most `refine::SPACING_BATCH` and
+    /// fails on the first bad value: run on the input vertices before meshing, so a broken
+    /// callback is reported at once, naming the point, instead of after boundary recovery.
     pub(crate) fn precheck(&self, points: &[DVec3]) -> Result<(), MeshError> {
         if points.is_empty() {
             return Ok(());
         }
         let mut out = vec![f64::NAN; points.len()];
-        self.at_many(points, &mut out);
+        let batch = crate::refine::SPACING_BATCH;
+        for (p, o) in points.chunks(batch).zip(out.chunks_mut(batch)) {
+            self.at_many(p, o);
+        }
         match points.iter().zip(&out).find(|(_, &v)| !valid_value(v)) {
             Some((&point, &value)) => Err(MeshError::BadSpacing { point, value }),
             None => Ok(()),

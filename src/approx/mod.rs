@@ -380,7 +380,11 @@ pub fn remesh(
         patch_of: &features.patch_of,
         repair: source.repaired(),
     };
-    let mesher = SurfaceMesher::new(geometry, f, Some(&thickness), criteria)?;
+    let mut mesher = SurfaceMesher::new(geometry, f, Some(&thickness), criteria)?;
+    mesher.set_region_caps(region_caps(
+        &source.region_attributes(),
+        &params.region_sizes,
+    )?);
     let (mut b, volume) = mesher.run_with_volume(crit, progress)?;
 
     let boundary = boundary_plc(input, &b, &surface, &features);
@@ -422,6 +426,29 @@ pub fn remesh(
         seconds: start.elapsed().as_secs_f64(),
     };
     Ok((remeshed, volume))
+}
+
+/// Per region number (0 outside, then `attributes[r - 1]`'s region) the most spacing its cells
+/// get (`Params::region_sizes`): empty when no size is given. An id no region has is an error
+/// listing the input's.
+fn region_caps(attributes: &[i32], sizes: &[(i32, f64)]) -> Result<Vec<f64>, MeshError> {
+    if sizes.is_empty() {
+        return Ok(vec![]);
+    }
+    let mut caps = vec![f64::INFINITY; attributes.len() + 1];
+    for &(id, h) in sizes {
+        if !attributes.contains(&id) {
+            return Err(crate::refine::unknown_region(id, attributes));
+        }
+        for (cap, _) in caps[1..]
+            .iter_mut()
+            .zip(attributes)
+            .filter(|(_, &a)| a == id)
+        {
+            *cap = cap.min(h);
+        }
+    }
+    Ok(caps)
 }
 
 /// The input as the approximate mode reads it: a checked PLC, or with `--repair` a dirty

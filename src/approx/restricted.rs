@@ -33,7 +33,7 @@ use crate::delaunay::tables::FACE;
 use crate::delaunay::{Cavity, Delaunay, Inserted, Probe, INFINITE};
 use crate::geom::tri_circumcenter;
 use crate::refine::outcome::{BoundaryKind, Outcome, Refusal};
-use crate::refine::{MeshError, Spacing};
+use crate::refine::{MeshError, Spacing, SPACING_BATCH};
 use crate::surface::oracle::{Crossing, SurfaceOracle};
 use crate::surface::repair::{Repaired, HIDDEN};
 use crate::surface::thickness::Thickness;
@@ -129,11 +129,19 @@ enum Bad {
     Boundary,
 }
 
-/// A bad facet waiting in the queue: larger surface balls first, ties by vertices.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// A bad facet waiting in the queue: larger surface balls first, ties by vertices. `sized`:
+/// the surface centre and the caller's spacing there when it was judged (reused when it is
+/// judged again with the same centre; not part of the order).
+#[derive(Debug, Clone, Copy)]
 struct Queued {
     radius: f64,
     face: [u32; 3],
+    sized: Option<(DVec3, f64)>,
+}
+impl PartialEq for Queued {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == Ordering::Equal
+    }
 }
 impl Eq for Queued {}
 impl PartialOrd for Queued {
@@ -211,6 +219,8 @@ pub struct SurfaceMesher<'a> {
     thin: Option<ThinBound>,
     /// Samples a repaired input's boundary was mended at (`rounds`), by coordinate bits.
     mended: FxHashSet<[u64; 3]>,
+    /// Per region number the most spacing its cells get (`Params::region_sizes`; empty: none).
+    region_caps: Vec<f64>,
 }
 
 /// The surface spacing's bound by the input's thickness, per input triangle.
@@ -308,6 +318,7 @@ impl<'a> SurfaceMesher<'a> {
             vol: None,
             input_samples: std::cell::OnceCell::new(),
             mended: FxHashSet::default(),
+            region_caps: vec![],
             thin: thickness.map(|t| ThinBound {
                 per_triangle: t.per_triangle(surface),
                 scale: criteria.thickness_spacing,
@@ -346,6 +357,11 @@ impl<'a> SurfaceMesher<'a> {
         Ok(m)
     }
 
+    /// Caps the cells' spacing per region number (see `approx::region_caps`).
+    pub fn set_region_caps(&mut self, caps: Vec<f64>) {
+        self.region_caps = caps;
+    }
+
     /// The surface spacing at `p`: the caller's, bounded by the thickness of the input
     /// triangle nearest to `p`.
     fn f(&mut self, p: DVec3) -> f64 {
@@ -359,9 +375,22 @@ impl<'a> SurfaceMesher<'a> {
     /// The surface spacing at `p`, a point of input triangle `triangle`.
     fn f_on(&mut self, p: DVec3, triangle: Option<u32>) -> f64 {
         let v = self.spacing.at(p);
+        self.f_value(p, v, triangle)
+    }
+
+    /// [`Self::f_on`] given `v`, the caller's spacing at `p` (evaluated in a batch).
+    fn f_value(&mut self, p: DVec3, v: f64, triangle: Option<u32>) -> f64 {
         if !(v.is_finite() && v > 0.0) {
             self.bad_spacing
                 .get_or_insert(MeshError::BadSpacing { point: p, value: v });
+        }
+        self.bounded(v, triangle)
+    }
+
+    /// [`Self::f_value`] without noting a bad value: infinite for one, else `v` bounded by
+    /// the thickness of `triangle`.
+    fn bounded(&self, v: f64, triangle: Option<u32>) -> f64 {
+        if !(v.is_finite() && v > 0.0) {
             return f64::INFINITY;
         }
         match (&self.thin, triangle) {
@@ -380,7 +409,21 @@ impl<'a> SurfaceMesher<'a> {
             .step_by(step)
             .copied()
             .collect();
-        let mut v: Vec<f64> = pts.into_iter().map(|p| self.f(p)).collect();
+        let mut raw = vec![f64::NAN; pts.len()];
+        if !pts.is_empty() {
+            self.spacing.at_many(&pts, &mut raw);
+        }
+        let mut v: Vec<f64> = pts
+            .into_iter()
+            .zip(raw)
+            .map(|(p, raw)| {
+                let triangle = match self.thin {
+                    Some(_) => self.oracle.closest(p).map(|c| c.triangle),
+                    None => None,
+                };
+                self.f_value(p, raw, triangle)
+            })
+            .collect();
         v.sort_by(f64::total_cmp);
         v.get(v.len() / 2).copied().unwrap_or(1.0)
     }
@@ -438,34 +481,75 @@ impl<'a> SurfaceMesher<'a> {
     /// would put four samples on one circle everywhere on a planar patch, and the Delaunay
     /// triangulation would be full of flat tets), greedy, at least 0.7 f from every accepted
     /// sample and curve point.
+    ///
+    /// The spacing is evaluated in batches (`Spacing::at_many`): first at every triangle's
+    /// centroid (which sets its number of draws), then at the draws of as many triangles as
+    /// make [`SPACING_BATCH`] points (the draws do not depend on the spacing); the values are
+    /// then used in the order of one by one.
     fn sample_patches(&mut self, points: &mut Vec<DVec3>, grid: &mut SampleGrid, seed: u64) {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        for t in 0..self.surface.triangles.len() {
-            let [a, b, c] = self.surface.corners(t);
-            let area = 0.5 * (b - a).cross(c - a).length();
-            let h = self.f_on((a + b + c) / 3.0, Some(t as u32));
-            let tries = ((4.0 * area / (h * h)).ceil() as usize).clamp(1, 1 << 16);
-            for _ in 0..tries {
-                let (mut u, mut v): (f64, f64) = (rng.gen(), rng.gen());
-                if u + v > 1.0 {
-                    (u, v) = (1.0 - u, 1.0 - v);
+        let n = self.surface.triangles.len();
+        let centroids: Vec<DVec3> = (0..n)
+            .map(|t| {
+                let [a, b, c] = self.surface.corners(t);
+                (a + b + c) / 3.0
+            })
+            .collect();
+        let mut at_centroid = vec![f64::NAN; n];
+        for (p, out) in centroids
+            .chunks(SPACING_BATCH)
+            .zip(at_centroid.chunks_mut(SPACING_BATCH))
+        {
+            self.spacing.at_many(p, out);
+        }
+        // Triangles whose draws are waiting for their spacing, and the draws.
+        let (mut group, mut draws, mut at_draw) = (vec![], vec![], vec![]);
+        let mut t = 0;
+        while t < n || !group.is_empty() {
+            if t < n && draws.len() < SPACING_BATCH {
+                let [a, b, c] = self.surface.corners(t);
+                let area = 0.5 * (b - a).cross(c - a).length();
+                let h = self.bounded(at_centroid[t], Some(t as u32));
+                let tries = ((4.0 * area / (h * h)).ceil() as usize).clamp(1, 1 << 16);
+                for _ in 0..tries {
+                    let (mut u, mut v): (f64, f64) = (rng.gen(), rng.gen());
+                    if u + v > 1.0 {
+                        (u, v) = (1.0 - u, 1.0 - v);
+                    }
+                    draws.push(a + (b - a) * u + (c - a) * v);
                 }
-                let p = a + (b - a) * u + (c - a) * v;
-                let r = 0.7 * self.f_on(p, Some(t as u32));
-                if grid.has_within(p, r) {
-                    continue;
-                }
-                // A repaired input's triangle may bound the solid in part only.
-                if self
-                    .repair
-                    .is_some_and(|rep| !rep.bounds_solid_at(p, self.surface.normal(t)))
-                {
-                    continue;
-                }
-                grid.add(p);
-                points.push(p);
-                self.loc.push(Loc::Patch(self.patch_of[t]));
+                group.push((t, tries));
+                t += 1;
+                continue;
             }
+            at_draw.clear();
+            at_draw.resize(draws.len(), f64::NAN);
+            self.spacing.at_many(&draws, &mut at_draw);
+            let mut k = 0;
+            for &(t, tries) in &group {
+                // Noted in the order of one by one (the first bad value is the error).
+                self.f_value(centroids[t], at_centroid[t], Some(t as u32));
+                for _ in 0..tries {
+                    let p = draws[k];
+                    let r = 0.7 * self.f_value(p, at_draw[k], Some(t as u32));
+                    k += 1;
+                    if grid.has_within(p, r) {
+                        continue;
+                    }
+                    // A repaired input's triangle may bound the solid in part only.
+                    if self
+                        .repair
+                        .is_some_and(|rep| !rep.bounds_solid_at(p, self.surface.normal(t)))
+                    {
+                        continue;
+                    }
+                    grid.add(p);
+                    points.push(p);
+                    self.loc.push(Loc::Patch(self.patch_of[t]));
+                }
+            }
+            group.clear();
+            draws.clear();
         }
     }
 
@@ -616,7 +700,7 @@ impl<'a> SurfaceMesher<'a> {
             }
             // Both queues empty: done, no stop reason.
             let q = self.facets.pop()?;
-            self.refine_facet(q.face);
+            self.refine_facet(q.face, q.sized);
         }
     }
 
@@ -825,20 +909,73 @@ impl<'a> SurfaceMesher<'a> {
         }
     }
 
-    fn is_bad(&mut self, r: &Restricted) -> bool {
-        self.badness(r) != Bad::No
+    /// Queues the bad ones of restricted facets `found`, in their order. The caller's
+    /// spacing at their surface centres is evaluated in batches (one `Spacing::at_many` call
+    /// per [`SPACING_BATCH`] facets: after an insertion, one for the facets it made), at the
+    /// same points as one by one.
+    fn queue_bad(&mut self, found: &[Restricted]) {
+        let (mut centres, mut values) = (vec![], vec![]);
+        for chunk in found.chunks(SPACING_BATCH) {
+            centres.clear();
+            centres.extend(
+                chunk
+                    .iter()
+                    .filter(|r| !self.topology_bad(r))
+                    .map(|r| r.centre),
+            );
+            values.clear();
+            values.resize(centres.len(), f64::NAN);
+            if !centres.is_empty() {
+                self.spacing.at_many(&centres, &mut values);
+            }
+            let mut k = 0;
+            for r in chunk {
+                let (bad, sized) = match self.topology_bad(r) {
+                    true => (Bad::Topology, None),
+                    false => {
+                        let v = values[k];
+                        k += 1;
+                        (self.badness_given(r, v), Some((r.centre, v)))
+                    }
+                };
+                if bad != Bad::No {
+                    self.facets.push(Queued {
+                        radius: r.radius,
+                        face: key3(r.vertices),
+                        sized,
+                    });
+                }
+            }
+        }
     }
 
     /// Which criterion a restricted facet fails first (angles are not enforced next to a
-    /// small corner).
-    fn badness(&mut self, r: &Restricted) -> Bad {
-        let patch = self.patch_of[r.triangle as usize];
-        let above_floor = r.radius >= self.criteria.feature_floor;
-        // A hole's span belongs to no patch.
-        if above_floor && !r.span && !r.vertices.iter().all(|&v| self.on_patch(v, patch)) {
+    /// small corner); `sized`: a surface centre and the caller's spacing there, used when the
+    /// centre is `r`'s (else the spacing is evaluated).
+    fn badness(&mut self, r: &Restricted, sized: Option<(DVec3, f64)>) -> Bad {
+        if self.topology_bad(r) {
             return Bad::Topology;
         }
-        if r.radius > self.f_on(r.centre, (!r.span).then_some(r.triangle)) {
+        let v = match sized {
+            Some((c, v)) if c == r.centre => v,
+            _ => self.spacing.at(r.centre),
+        };
+        self.badness_given(r, v)
+    }
+
+    /// Whether restricted facet `r` has a vertex off its patch (a hole's span belongs to no
+    /// patch; facets below the feature floor are not checked).
+    fn topology_bad(&self, r: &Restricted) -> bool {
+        let patch = self.patch_of[r.triangle as usize];
+        let above_floor = r.radius >= self.criteria.feature_floor;
+        above_floor && !r.span && !r.vertices.iter().all(|&v| self.on_patch(v, patch))
+    }
+
+    /// [`Self::badness`] of a facet without a topology fault, given `v`, the caller's spacing
+    /// at its surface centre.
+    fn badness_given(&mut self, r: &Restricted, v: f64) -> Bad {
+        let above_floor = r.radius >= self.criteria.feature_floor;
+        if r.radius > self.f_value(r.centre, v, (!r.span).then_some(r.triangle)) {
             return Bad::Size;
         }
         let [a, b, c] = r.vertices.map(|v| self.dt.point(v));
@@ -869,14 +1006,14 @@ impl<'a> SurfaceMesher<'a> {
         Bad::No
     }
 
-    fn refine_facet(&mut self, face: [u32; 3]) {
+    fn refine_facet(&mut self, face: [u32; 3], sized: Option<(DVec3, f64)>) {
         let Some([(t, i), _]) = self.dt.find_face(face[0], face[1], face[2]) else {
             return;
         };
         let Some(r) = self.facet_at(t, i) else {
             return;
         };
-        let why = self.badness(&r);
+        let why = self.badness(&r, sized);
         if why != Bad::No {
             self.insert_surface_point(r, t, why);
         }
@@ -916,6 +1053,7 @@ impl<'a> SurfaceMesher<'a> {
             self.facets.push(Queued {
                 radius: r.radius,
                 face: key3(r.vertices),
+                sized: None,
             });
             return Outcome::Queued(BoundaryKind::Segment);
         }

@@ -29,6 +29,11 @@ pub struct MeshOptions {
     /// background, the nearest tet's value. Conflicts with --size.
     #[arg(long, value_name = "FILE", conflicts_with = "size")]
     pub size_field: Option<std::path::PathBuf>,
+    /// Maximum size H in the region of attribute ID (repeatable): its tets get spacing at
+    /// most H, the smaller of H and the spacing (automatic, --size or --size-field) there.
+    #[arg(long = "region-size", value_name = "ID:H", value_parser = parse_id_size,
+          allow_hyphen_values = true)]
+    pub region_size: Vec<(i32, f64)>,
     /// Radius-edge bound rho0 (default 2).
     #[arg(long, value_name = "R")]
     pub rho: Option<f64>,
@@ -156,8 +161,28 @@ impl MeshOptions {
         if let Some(v) = self.small_angle_reach {
             p.small_angle_reach = v;
         }
+        p.region_sizes = self.region_size.clone();
         p
     }
+}
+
+/// `ID:H` of `--region-size`: an integer id and a size, finite and > 0.
+fn parse_id_size(s: &str) -> Result<(i32, f64), String> {
+    let (id, h) = s
+        .split_once(':')
+        .ok_or_else(|| format!("\"{s}\" is not ID:H (e.g. 2:0.05)"))?;
+    let id: i32 = id
+        .trim()
+        .parse()
+        .map_err(|e| format!("ID \"{id}\" of \"{s}\" is not an integer: {e}"))?;
+    let h: f64 = h
+        .trim()
+        .parse()
+        .map_err(|e| format!("H \"{h}\" of \"{s}\" is not a number: {e}"))?;
+    if !(h.is_finite() && h > 0.0) {
+        return Err(format!("H = {h} of \"{s}\" must be finite and > 0"));
+    }
+    Ok((id, h))
 }
 
 /// Meshes `input` (.poly/.smesh/.off/.stl/.ply/.obj, or an existing .mesh whose slivers are

@@ -16,7 +16,8 @@ pub type sm_spacing_fn =
     Option<unsafe extern "C" fn(x: f64, y: f64, z: f64, user_data: *mut c_void) -> f64>;
 
 /// Batched spacing callback: writes the spacing at the `n` points `xyz[3*i..3*i+3]` into
-/// `out[i]`. Entries left unwritten count as NaN (an error).
+/// `out[i]`. Entries left unwritten count as NaN (an error). `n` >= 1, at most 4,096 (see
+/// `sm_set_spacing_batch_cb` for how the points are grouped).
 #[allow(non_camel_case_types)]
 pub type sm_spacing_batch_fn =
     Option<unsafe extern "C" fn(n: usize, xyz: *const f64, out: *mut f64, user_data: *mut c_void)>;

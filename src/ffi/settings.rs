@@ -121,6 +121,15 @@ pub unsafe extern "C" fn sm_set_spacing_cb(
 /// `sm_spacing_batch_fn`: one call per batch of points); replaces any other spacing. `f` == NULL
 /// removes it: spacing becomes automatic.
 ///
+/// Batches: the input vertices, once before meshing; during refinement, all the tets (keep
+/// mode) or cells and surface facets (approximate mode) that one insertion created, in one
+/// call (typically 20 to 40 points; 34 on average on a graded cube of 900,000 tets); the
+/// first classification of the whole triangulation, the approximate mode's surface samples and
+/// the report's size figures in calls of at most 4,096 points. A few evaluations stay single
+/// points: a tet looked at again after a boundary split, the approximate mode's feature-curve
+/// sampling and subsegment lengths (each step depends on the previous value). The values are
+/// the same as with `sm_set_spacing_cb` and the same function, and so is the mesh.
+///
 /// # Safety
 /// As `sm_set_spacing_cb`, with the `sm_spacing_batch_fn` signature.
 #[no_mangle]
@@ -134,6 +143,24 @@ pub unsafe extern "C" fn sm_set_spacing_batch_cb(
     handle_call(handle, "sm_set_spacing_batch_cb", |st| {
         st.mesher.set_spacing_automatic();
         st.spacing_cb = f.map(|f| CSpacing::batch(f, user_data));
+        Ok(())
+    })
+}
+
+/// Limits the spacing in the region of attribute `id` to at most `h` (finite, > 0;
+/// `SM_ERR_INVALID_ARGUMENT` otherwise): its tets get the smaller of `h` and the spacing there
+/// (CLI `--region-size ID:H`). Again for the same `id`, the new `h` replaces the old. An `id`
+/// the input has no region of makes `sm_refine` fail with `SM_ERR_INVALID_INPUT`, the message
+/// naming it and listing the input's regions.
+///
+/// # Safety
+/// `m` is NULL or a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn sm_set_region_size(m: *mut sm_mesher, id: i32, h: f64) -> sm_status {
+    // SAFETY: `m` is NULL or a live handle (contract above).
+    let handle = unsafe { m.as_ref() };
+    handle_call(handle, "sm_set_region_size", |st| {
+        st.mesher.set_region_size(id, h)?;
         Ok(())
     })
 }

@@ -20,6 +20,39 @@ pub struct Regions {
     pub max_size: Vec<Option<f64>>,
 }
 
+impl Regions {
+    /// Caps the size limit of every component whose attribute is a region id of `sizes`
+    /// (`Params::region_sizes`) by its size; an id no component has is an error listing the
+    /// input's region attributes.
+    pub fn limit_sizes(&mut self, sizes: &[(i32, f64)]) -> Result<(), MeshError> {
+        for &(id, h) in sizes {
+            let mut found = false;
+            for (a, m) in self.attribute.iter().zip(&mut self.max_size).skip(1) {
+                if *a == id {
+                    found = true;
+                    *m = Some(m.map_or(h, |m| m.min(h)));
+                }
+            }
+            if !found {
+                return Err(unknown_region(id, &self.attribute[1..]));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The error for a region size given for region `id`, which none of `attributes` is.
+pub(crate) fn unknown_region(id: i32, attributes: &[i32]) -> MeshError {
+    let mut known: Vec<i32> = attributes.to_vec();
+    known.sort_unstable();
+    known.dedup();
+    let list: Vec<String> = known.iter().map(|a| a.to_string()).collect();
+    MeshError::InvalidInput(format!(
+        "region size given for region {id}, but the input has no such region (its regions: {})",
+        list.join(", ")
+    ))
+}
+
 /// What a component without a region seed becomes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Unseeded {

@@ -17,7 +17,9 @@ mod recover;
 pub mod report;
 mod spacing;
 
+pub(crate) use mark::unknown_region;
 pub use outcome::Refusals;
+pub use quality::SPACING_BATCH;
 pub use spacing::AutoSpacing;
 
 use crate::mesh::TetMesh;
@@ -83,6 +85,10 @@ pub struct Params {
     /// Element order of the output: 1 (four-node tets) or 2 (ten-node tets, boundary nodes on
     /// the input surface where the surface mode knows it; `crate::quadratic`).
     pub order: u8,
+    /// Maximum sizes per region attribute (`--region-size ID:H`): the tets of region ID get
+    /// spacing at most H (the smaller of it and the spacing's value). Each H finite and > 0;
+    /// an ID the input does not have is an error. Not a parameter by name.
+    pub region_sizes: Vec<(i32, f64)>,
 }
 
 /// Default improvement target (degrees) in keep mode: every acute-free model reaches 25.
@@ -127,6 +133,7 @@ impl Default for Params {
             improve_target: 0.0,
             repair: false,
             order: 1,
+            region_sizes: Vec::new(),
         }
     }
 }
@@ -209,6 +216,13 @@ impl Params {
                  the mode's default, 26 keep / 20 approximate)",
                 self.improve_target
             ));
+        }
+        for &(id, h) in &self.region_sizes {
+            if !(h.is_finite() && h > 0.0) {
+                return Err(format!(
+                    "region size for region {id}: h = {h} must be finite and > 0"
+                ));
+            }
         }
         if self.delta >= 1.0 {
             return Err(format!("parameter delta = {} must be < 1", self.delta));
@@ -504,6 +518,7 @@ fn mesh_domain(
         return Err(recovery_budget_spent(params));
     }
     let mut regions = dom.mark_domain(&plc, unseeded)?;
+    regions.limit_sizes(&params.region_sizes)?;
     let seconds_recovery = start.elapsed().as_secs_f64();
     let auto;
     let spacing: &dyn Spacing = match spacing {
@@ -630,6 +645,7 @@ fn refine_passes(
             return Err(recovery_budget_spent(ctx.params));
         }
         *regions = dom.mark_domain(ctx.plc, ctx.unseeded)?;
+        regions.limit_sizes(&ctx.params.region_sizes)?;
         let relabelled = labels
             .iter()
             .zip(tet_labels(dom, regions))

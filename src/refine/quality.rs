@@ -60,6 +60,35 @@ impl Ord for Bad {
     }
 }
 
+/// A tet's classification before its spacing is known ([`Refiner::prepare_classify`]).
+enum Step {
+    Done(Option<Bad>),
+    Need(Pending),
+}
+
+/// A tet waiting for the spacing at `query` (the centroid next to a small angle, where
+/// `circum` is None; else the circumcentre, `circum` its offset from the first vertex and the
+/// orientation determinant).
+#[derive(Clone, Copy)]
+struct Pending {
+    tet: u32,
+    verts: [u32; 4],
+    tag: u32,
+    query: DVec3,
+    circum: Option<(DVec3, f64)>,
+}
+
+/// The most tets classified with one batched spacing evaluation (`Spacing::at_many`).
+pub const SPACING_BATCH: usize = 4096;
+
+/// Reused buffers of the batched classification.
+#[derive(Default)]
+struct Batch {
+    steps: Vec<Step>,
+    queries: Vec<DVec3>,
+    values: Vec<f64>,
+}
+
 /// Circumradius / longest edge above which a bad tet is deferred (see `refine_tet`).
 const DEFER_RADIUS_PER_EDGE: f64 = 3.0;
 
@@ -89,6 +118,8 @@ pub struct Refiner<'a> {
     pub stop_reason: Option<String>,
     /// The bounding box of the input vertices.
     domain_box: BoundingBox,
+    /// Buffers of the batched classification (`push_tets`).
+    batch: Batch,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -139,32 +170,82 @@ impl<'a> Refiner<'a> {
             futile: FxHashSet::default(),
             stop_reason: None,
             domain_box: BoundingBox { lo, hi },
+            batch: Batch::default(),
         }
     }
 
-    /// Spacing at `p` for a tet of region tag `tag`: the user's f, capped by the region's
-    /// maximum size; a value that is not finite and positive is an error.
-    pub fn spacing_at(&self, p: DVec3, tag: u32) -> Result<f64, MeshError> {
-        let mut f = self.spacing.at(p);
+    /// The spacing value `f` the user's function gave at `p`, for a tet of region tag `tag`:
+    /// capped by the region's maximum size; a value that is not finite and positive is an
+    /// error naming `p`.
+    fn capped_spacing(&self, p: DVec3, f: f64, tag: u32) -> Result<f64, MeshError> {
         if !(f.is_finite() && f > 0.0) {
             return Err(MeshError::BadSpacing { point: p, value: f });
         }
-        if let Some(m) = self.regions.max_size.get(tag as usize).copied().flatten() {
-            f = f.min(m);
-        }
-        Ok(f)
+        Ok(
+            match self.regions.max_size.get(tag as usize).copied().flatten() {
+                Some(m) => f.min(m),
+                None => f,
+            },
+        )
     }
 
-    fn classify(&self, t: u32) -> Result<Option<Bad>, MeshError> {
+    /// Classification of tet `t` up to the spacing it needs: done (not a domain tet, or a
+    /// sliver without a circumsphere), or the point whose spacing decides the rest
+    /// ([`Refiner::finish_classify`]). Next to a small angle that point is the centroid (size
+    /// by the longest edge), else the circumcentre.
+    fn prepare_classify(&self, t: u32) -> Step {
         // Tets logged as created may have been deleted again by a later insertion.
         if !self.dom.dt.is_alive(t) {
-            return Ok(None);
+            return Step::Done(None);
         }
         let tag = self.dom.dt.tag(t);
         if tag == 0 || !self.dom.dt.is_finite(t) {
-            return Ok(None);
+            return Step::Done(None);
         }
         let verts = self.dom.dt.tet(t);
+        let [a, b, c, d] = verts.map(|v| self.dom.point(v));
+        let near = verts.iter().any(|&v| self.dom.near_small_angle(v));
+        if near {
+            // Next to a small input angle size is measured by the longest edge: the tets there
+            // may stay flat, and a flat tet's circumradius says nothing about its size.
+            return Step::Need(Pending {
+                tet: t,
+                verts,
+                tag,
+                query: (a + b + c + d) * 0.25,
+                circum: None,
+            });
+        }
+        let (u, v, w) = (b - a, c - a, d - a);
+        let (vw, wu, uv) = (v.cross(w), w.cross(u), u.cross(v));
+        let lu = [u.length_squared(), v.length_squared(), w.length_squared()];
+        let det = orient3d(a, b, c, d);
+        let Some(offset) = circum_offset_crossed([vw, wu, uv], lu, det) else {
+            return Step::Done(Some(Bad {
+                class: SLIVER,
+                badness: f64::INFINITY,
+                tet: t,
+                verts,
+            }));
+        };
+        Step::Need(Pending {
+            tet: t,
+            verts,
+            tag,
+            query: a + offset,
+            circum: Some((offset, det)),
+        })
+    }
+
+    /// The rest of [`Refiner::prepare_classify`] given `f`, the spacing at the pending tet's
+    /// query point (region cap applied): the tet's badness class, if any.
+    fn finish_classify(&self, p: &Pending, f: f64) -> Option<Bad> {
+        let Pending {
+            tet: t,
+            verts,
+            circum,
+            ..
+        } = *p;
         let [a, b, c, d] = verts.map(|v| self.dom.point(v));
         let bad = |class, badness| {
             Some(Bad {
@@ -174,15 +255,11 @@ impl<'a> Refiner<'a> {
                 verts,
             })
         };
-        let near = verts.iter().any(|&v| self.dom.near_small_angle(v));
+        let near = circum.is_none();
         if near {
-            // Next to a small input angle size is measured by the longest edge: the tets there
-            // may stay flat, and a flat tet's circumradius says nothing about its size.
-            let centroid = (a + b + c + d) * 0.25;
-            let xi =
-                longest_edge(a, b, c, d) / (EDGE_PER_RADIUS * self.spacing_at(centroid, tag)?);
+            let xi = longest_edge(a, b, c, d) / (EDGE_PER_RADIUS * f);
             if xi > self.params.size_factor {
-                return Ok(bad(SIZE, xi));
+                return bad(SIZE, xi);
             }
         }
         // The measures, each computed only when the tests before it pass, sharing the edge
@@ -191,15 +268,21 @@ impl<'a> Refiner<'a> {
         let (u, v, w) = (b - a, c - a, d - a);
         let (vw, wu, uv) = (v.cross(w), w.cross(u), u.cross(v));
         let lu = [u.length_squared(), v.length_squared(), w.length_squared()];
-        let det = orient3d(a, b, c, d);
-        let Some(offset) = circum_offset_crossed([vw, wu, uv], lu, det) else {
-            return Ok(bad(SLIVER, f64::INFINITY));
+        let (offset, det) = match circum {
+            Some(known) => known,
+            None => {
+                let det = orient3d(a, b, c, d);
+                let Some(offset) = circum_offset_crossed([vw, wu, uv], lu, det) else {
+                    return bad(SLIVER, f64::INFINITY);
+                };
+                (offset, det)
+            }
         };
-        let (centre, circumradius) = (a + offset, offset.length());
+        let circumradius = offset.length();
         if !near {
-            let xi = circumradius / self.spacing_at(centre, tag)?;
+            let xi = circumradius / f;
             if xi > self.params.size_factor {
-                return Ok(bad(SIZE, xi));
+                return bad(SIZE, xi);
             }
         }
         let e = [
@@ -213,7 +296,7 @@ impl<'a> Refiner<'a> {
         let l2 = e[0].min(e[1]).min(e[2]).min(e[3]).min(e[4]).min(e[5]);
         let rho = circumradius / l2.sqrt();
         if rho > self.params.rho0 {
-            return Ok(bad(RATIO, rho));
+            return bad(RATIO, rho);
         }
         let n = [
             (d - b).cross(c - b).length_squared(),
@@ -222,14 +305,14 @@ impl<'a> Refiner<'a> {
             uv.length_squared(),
         ];
         if self.picker.screen().clears(det, e, l2, n) {
-            return Ok(None);
+            return None;
         }
         let (sigma, max_cos_dihedral) = sliver_measures(a, b, c, d, l2);
-        Ok(if self.picker.slivers.is_sliver(sigma, max_cos_dihedral) {
+        if self.picker.slivers.is_sliver(sigma, max_cos_dihedral) {
             bad(SLIVER, max_cos_dihedral)
         } else {
             None
-        })
+        }
     }
 
     /// Queues the bad tets among those created since the last call.
@@ -243,10 +326,46 @@ impl<'a> Refiner<'a> {
         self.push_tets(&recent)
     }
 
+    /// Classifies `tets` and queues the bad ones, in their order. The spacing they need is
+    /// evaluated in batches (one `Spacing::at_many` call per [`SPACING_BATCH`] tets: after an
+    /// insertion, one call for all the tets it created), each at the same point as one by one,
+    /// so the values and the queues are the same.
     fn push_tets(&mut self, tets: &[u32]) -> Result<(), MeshError> {
-        for &t in tets {
-            if let Some(b) = self.classify(t)? {
-                self.queues[b.class as usize].push_back(b);
+        let mut scratch = std::mem::take(&mut self.batch);
+        let result = self.push_tets_with(tets, &mut scratch);
+        self.batch = scratch;
+        result
+    }
+
+    fn push_tets_with(&mut self, tets: &[u32], s: &mut Batch) -> Result<(), MeshError> {
+        for chunk in tets.chunks(SPACING_BATCH) {
+            s.steps.clear();
+            s.queries.clear();
+            for &t in chunk {
+                let step = self.prepare_classify(t);
+                if let Step::Need(p) = &step {
+                    s.queries.push(p.query);
+                }
+                s.steps.push(step);
+            }
+            s.values.clear();
+            s.values.resize(s.queries.len(), f64::NAN);
+            if !s.queries.is_empty() {
+                self.spacing.at_many(&s.queries, &mut s.values);
+            }
+            let mut k = 0;
+            for step in &s.steps {
+                let b = match step {
+                    Step::Done(b) => *b,
+                    Step::Need(p) => {
+                        let f = self.capped_spacing(p.query, s.values[k], p.tag)?;
+                        k += 1;
+                        self.finish_classify(p, f)
+                    }
+                };
+                if let Some(b) = b {
+                    self.queues[b.class as usize].push_back(b);
+                }
             }
         }
         Ok(())

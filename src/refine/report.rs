@@ -1,5 +1,6 @@
 //! The figures reported after every run: counts, achieved quality and size conformity.
 
+use super::quality::SPACING_BATCH;
 use super::{MeshError, Params, Report, Spacing};
 use crate::geom::TetQuality;
 use crate::mesh::TetMesh;
@@ -73,26 +74,46 @@ pub fn measure(
     let mut r = Report::default();
     let mut shapes = Shapes::new();
     let p = |v: u32| mesh.vertices[v as usize];
-    for t in &mesh.tets {
-        let q = TetQuality::of(p(t[0]), p(t[1]), p(t[2]), p(t[3]));
-        shapes.add(&q);
-        if q.rho > params.rho0 || q.sigma < params.sigma0 || q.min_dihedral < params.min_dihedral {
-            if near_small_angle(t) {
-                r.n_bad_near_acute += 1;
-            } else {
-                bad_elsewhere += 1;
+    // The spacing is evaluated in batches of `SPACING_BATCH` points (one `at_many` call each).
+    let mut centres = Vec::with_capacity(SPACING_BATCH);
+    let mut radii = Vec::with_capacity(SPACING_BATCH);
+    let mut f = Vec::with_capacity(SPACING_BATCH);
+    for chunk in mesh.tets.chunks(SPACING_BATCH) {
+        centres.clear();
+        radii.clear();
+        for t in chunk {
+            let q = TetQuality::of(p(t[0]), p(t[1]), p(t[2]), p(t[3]));
+            shapes.add(&q);
+            if q.rho > params.rho0
+                || q.sigma < params.sigma0
+                || q.min_dihedral < params.min_dihedral
+            {
+                if near_small_angle(t) {
+                    r.n_bad_near_acute += 1;
+                } else {
+                    bad_elsewhere += 1;
+                }
+            }
+            if let Some(c) = q.circumcenter {
+                centres.push(c);
+                radii.push(q.circumradius);
             }
         }
-        if let Some(c) = q.circumcenter {
-            let f = checked(spacing, c)?;
-            r.max_size_ratio = r.max_size_ratio.max(q.circumradius / f);
+        checked_batch(spacing, &centres, &mut f)?;
+        for (&radius, &f) in radii.iter().zip(&f) {
+            r.max_size_ratio = r.max_size_ratio.max(radius / f);
         }
     }
     let edges = unique_edges(&mesh.tets, mesh.vertices.len());
     let mut ratios = Vec::with_capacity(edges.len());
-    for (a, b) in edges {
-        let mid = (p(a) + p(b)) * 0.5;
-        ratios.push(p(a).distance(p(b)) / checked(spacing, mid)?);
+    let mut mids = Vec::with_capacity(SPACING_BATCH);
+    for chunk in edges.chunks(SPACING_BATCH) {
+        mids.clear();
+        mids.extend(chunk.iter().map(|&(a, b)| (p(a) + p(b)) * 0.5));
+        checked_batch(spacing, &mids, &mut f)?;
+        for (&(a, b), &f) in chunk.iter().zip(&f) {
+            ratios.push(p(a).distance(p(b)) / f);
+        }
     }
     if !ratios.is_empty() {
         // The element a full sort would put at len / 2, without the sort.
@@ -145,12 +166,25 @@ fn unique_edges(tets: &[[u32; 4]], n_vertices: usize) -> Vec<(u32, u32)> {
     edges
 }
 
-fn checked(spacing: &dyn Spacing, p: glam::DVec3) -> Result<f64, MeshError> {
-    let f = spacing.at(p);
-    if f.is_finite() && f > 0.0 {
-        Ok(f)
-    } else {
-        Err(MeshError::BadSpacing { point: p, value: f })
+/// The spacing at `points` into `out`, in one `at_many` call; the first value that is not
+/// finite and positive is an error naming its point.
+fn checked_batch(
+    spacing: &dyn Spacing,
+    points: &[glam::DVec3],
+    out: &mut Vec<f64>,
+) -> Result<(), MeshError> {
+    out.clear();
+    out.resize(points.len(), f64::NAN);
+    if !points.is_empty() {
+        spacing.at_many(points, out);
+    }
+    match points
+        .iter()
+        .zip(out.iter())
+        .find(|(_, &f)| !(f.is_finite() && f > 0.0))
+    {
+        Some((&point, &value)) => Err(MeshError::BadSpacing { point, value }),
+        None => Ok(()),
     }
 }
 

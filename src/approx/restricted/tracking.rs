@@ -9,7 +9,7 @@
 //! tet to the other (a ray decides where a crossing is not proper or a circumcentre is missing;
 //! with one region this is the parity of the crossings).
 
-use super::{key3, Queued, Restricted, SurfaceMesher};
+use super::{key3, Restricted, SurfaceMesher};
 use crate::delaunay::tables::FACE;
 use crate::delaunay::{Delaunay, INFINITE};
 use crate::geom::circumsphere;
@@ -147,21 +147,10 @@ impl SurfaceMesher<'_> {
                 .map(|r| (key3(r.vertices), (r.centre, r.radius, r.triangle, r.span)))
                 .collect(),
         };
-        for r in classified.restricted {
-            self.queue_if_bad(r);
-        }
+        self.queue_bad(&classified.restricted);
         #[cfg(test)]
         if CHECK_EVERY_INSERTION.get() {
             self.assert_restricted_bits();
-        }
-    }
-
-    fn queue_if_bad(&mut self, r: Restricted) {
-        if self.is_bad(&r) {
-            self.facets.push(Queued {
-                radius: r.radius,
-                face: key3(r.vertices),
-            });
         }
     }
 
@@ -368,9 +357,7 @@ impl SurfaceMesher<'_> {
             }
         }
         self.track = track;
-        for r in found {
-            self.queue_if_bad(r);
-        }
+        self.queue_bad(&found);
         #[cfg(test)]
         if CHECK_EVERY_INSERTION.get() {
             self.assert_restricted_bits();

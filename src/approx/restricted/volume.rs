@@ -44,6 +44,21 @@ pub struct VolumeCriteria {
     pub seed: u64,
 }
 
+/// A cell's circumcentre and the spacing there, as evaluated when it was classified (looked
+/// at again with the same centre, the cell reuses the value instead of a second evaluation).
+type Sized = Option<(DVec3, f64)>;
+
+/// The most cells classified with one batched spacing evaluation (`Spacing::at_many`).
+const SPACING_BATCH: usize = crate::refine::SPACING_BATCH;
+
+/// A cell's classification before its spacing is known.
+enum CellStep {
+    /// Good, outside, or next to a small corner.
+    Done(Option<usize>),
+    /// The spacing at the circumcentre `centre` (radius `r`) decides.
+    Need { centre: DVec3, r: f64 },
+}
+
 /// Cell classes, in the order they are refined (the last queue first).
 const SLIVER: usize = 0;
 const RATIO: usize = 1;
@@ -67,7 +82,8 @@ pub(super) struct VolumeState {
     slivers: SliverBounds,
     /// Li's point choice (small slivers, random draws); None while lent out.
     picker: Option<Picker>,
-    queues: [VecDeque<(u32, [u32; 4])>; 3],
+    /// Bad cells: id, vertices, and the spacing at the circumcentre they were classified with.
+    queues: [VecDeque<(u32, [u32; 4], Sized)>; 3],
     deferrals: FxHashMap<[u32; 4], u8>,
     pub(super) spacing: Option<AutoSpacing>,
     /// Per vertex id: within a small corner's ball (cells there are left as they are).
@@ -108,9 +124,7 @@ impl SurfaceMesher<'_> {
         }));
         self.mark_near_small_corners();
         let tets: Vec<u32> = self.dt.finite_tet_ids().collect();
-        for t in tets {
-            self.queue_cell(t);
-        }
+        self.queue_batch(&tets);
     }
 
     /// Extends the per-vertex small-corner flags to the vertices inserted since.
@@ -155,47 +169,113 @@ impl SurfaceMesher<'_> {
     pub(super) fn queue_cells(&mut self, created: &[u32]) {
         if self.vol.is_some() {
             self.mark_near_small_corners();
-            for &t in created {
-                self.queue_cell(t);
+            self.queue_batch(created);
+        }
+    }
+
+    /// Classifies `tets` and queues the bad ones, in their order. The spacing at their
+    /// circumcentres is evaluated in batches (one `Spacing::at_many` call per
+    /// [`SPACING_BATCH`] cells: after an insertion, one for all the cells it created), at the
+    /// same points as one by one.
+    fn queue_batch(&mut self, tets: &[u32]) {
+        let mut steps = Vec::with_capacity(tets.len().min(SPACING_BATCH));
+        let mut centres = Vec::with_capacity(steps.capacity());
+        let mut values = Vec::with_capacity(steps.capacity());
+        for chunk in tets.chunks(SPACING_BATCH) {
+            steps.clear();
+            centres.clear();
+            for &t in chunk {
+                let step = self.prepare_cell(t);
+                if let CellStep::Need { centre, .. } = step {
+                    centres.push(centre);
+                }
+                steps.push(step);
+            }
+            values.clear();
+            values.resize(centres.len(), f64::NAN);
+            if !centres.is_empty() {
+                self.cell_spacing().at_many(&centres, &mut values);
+            }
+            let mut k = 0;
+            for (&t, step) in chunk.iter().zip(&steps) {
+                let (class, sized) = match *step {
+                    CellStep::Done(class) => (class, None),
+                    CellStep::Need { centre, r } => {
+                        let f = values[k];
+                        k += 1;
+                        (self.finish_cell(t, r, f), Some((centre, f)))
+                    }
+                };
+                if let Some(class) = class {
+                    let tv = self.dt.tet(t);
+                    if let Some(vol) = self.vol.as_mut() {
+                        vol.queues[class].push_back((t, tv, sized));
+                    }
+                }
             }
         }
     }
 
-    fn queue_cell(&mut self, t: u32) {
-        if let Some(class) = self.cell_class(t) {
-            let tv = self.dt.tet(t);
-            if let Some(vol) = self.vol.as_mut() {
-                vol.queues[class].push_back((t, tv));
-            }
+    /// The spacing cells are sized by: the automatic one, or the caller's.
+    fn cell_spacing(&self) -> &dyn Spacing {
+        match self.vol.as_ref().and_then(|v| v.spacing.as_ref()) {
+            Some(s) => s,
+            None => self.spacing,
         }
     }
 
     /// The class of a bad inside cell, or None when it is good, outside or next to a small
-    /// corner.
-    fn cell_class(&self, t: u32) -> Option<usize> {
-        let vol = self.vol.as_ref()?;
+    /// corner; `sized`: the centre and spacing it was classified with before, reused when the
+    /// centre is the same. Returns the centre and spacing used too.
+    fn cell_class(&self, t: u32, sized: Sized) -> (Option<usize>, Sized) {
+        match self.prepare_cell(t) {
+            CellStep::Done(class) => (class, None),
+            CellStep::Need { centre, r } => {
+                let f = match sized {
+                    Some((c, f)) if c == centre => f,
+                    _ => self.cell_spacing().at(centre),
+                };
+                (self.finish_cell(t, r, f), Some((centre, f)))
+            }
+        }
+    }
+
+    /// [`Self::cell_class`] up to the spacing it needs.
+    fn prepare_cell(&self, t: u32) -> CellStep {
+        let Some(vol) = self.vol.as_ref() else {
+            return CellStep::Done(None);
+        };
         if !self.dt.is_alive(t) || !self.is_inside(t) {
-            return None;
+            return CellStep::Done(None);
         }
         let tv = self.dt.tet(t);
         if tv.contains(&INFINITE) || tv.iter().any(|&v| self.loc[v as usize] == Loc::Far) {
-            return None;
+            return CellStep::Done(None);
         }
         let near_small = |v: u32| match vol.near_small.get(v as usize) {
             Some(&near) => near,
             None => self.near_small_corner(self.dt.point(v)),
         };
         if tv.iter().any(|&v| near_small(v)) {
-            return None;
+            return CellStep::Done(None);
         }
-        let (centre, r) = self.sphere_of(t)?;
-        let f = match &vol.spacing {
-            Some(s) => s.at(centre),
-            None => self.spacing.at(centre),
+        match self.sphere_of(t) {
+            Some((centre, r)) => CellStep::Need { centre, r },
+            None => CellStep::Done(None),
+        }
+    }
+
+    /// The rest of [`Self::cell_class`], given `f` at the circumcentre (radius `r`).
+    fn finish_cell(&self, t: u32, r: f64, f: f64) -> Option<usize> {
+        let vol = self.vol.as_ref()?;
+        let f = match self.region_caps.get(self.region_of(t) as usize) {
+            Some(&cap) => f.min(cap),
+            None => f,
         };
         if r > vol.crit.size_factor * f {
             return Some(SIZE);
         }
+        let tv = self.dt.tet(t);
         let [a, b, c, d] = tv.map(|v| self.dt.point(v));
         let l2 = shortest_edge_sq(a, b, c, d);
         if r * r > vol.crit.rho0 * vol.crit.rho0 * l2 {
@@ -205,13 +285,14 @@ impl SurfaceMesher<'_> {
         vol.slivers.is_sliver(sigma, max_cos).then_some(SLIVER)
     }
 
-    /// The next bad cell still present, largest class first.
-    fn next_cell(&mut self) -> Option<u32> {
+    /// The next bad cell still present, largest class first, with the centre and spacing it
+    /// was classified with.
+    fn next_cell(&mut self) -> Option<(u32, Sized)> {
         loop {
             let vol = self.vol.as_mut()?;
-            let (t, tv) = vol.queues.iter_mut().rev().find_map(|q| q.pop_front())?;
+            let (t, tv, sized) = vol.queues.iter_mut().rev().find_map(|q| q.pop_front())?;
             if self.dt.is_alive(t) && self.dt.tet(t) == tv {
-                return Some(t);
+                return Some((t, sized));
             }
         }
     }
@@ -242,14 +323,14 @@ impl SurfaceMesher<'_> {
             if self.bad_spacing.is_some() {
                 return None;
             }
-            let t = self.next_cell()?;
-            if self.cell_class(t).is_some() {
-                self.refine_cell(t);
+            let (t, sized) = self.next_cell()?;
+            if let (Some(_), sized) = self.cell_class(t, sized) {
+                self.refine_cell(t, sized);
             }
         }
     }
 
-    fn refine_cell(&mut self, t: u32) {
+    fn refine_cell(&mut self, t: u32, sized: Sized) {
         let tv = self.dt.tet(t);
         let Some((centre, r)) = self.sphere_of(t) else {
             return;
@@ -259,7 +340,7 @@ impl SurfaceMesher<'_> {
         };
         match self.conflict(&cavity, r, Request::Shape) {
             Conflict::Free => {}
-            Conflict::Encroaches(e) => return self.yield_to_surface(t, tv, e),
+            Conflict::Encroaches(e) => return self.yield_to_surface(t, tv, e, sized),
             Conflict::Refused(_) => return,
         }
         let Some(mut picker) = self.lend_picker() else {
@@ -281,7 +362,7 @@ impl SurfaceMesher<'_> {
     /// The surface or a subsegment is refined for cell `t` instead of it (the facet level
     /// refines the facet now or queues the subsegments); the cell waits (a limited number of
     /// times: next to a refusing facet it is left).
-    fn yield_to_surface(&mut self, t: u32, tv: [u32; 4], encroached: Encroached) {
+    fn yield_to_surface(&mut self, t: u32, tv: [u32; 4], encroached: Encroached, sized: Sized) {
         let Some(mut picker) = self.lend_picker() else {
             return;
         };
@@ -298,9 +379,9 @@ impl SurfaceMesher<'_> {
         let n = vol.deferrals.entry(key).or_default();
         *n += 1;
         if *n <= MAX_CELL_DEFERRALS {
-            let class = self.cell_class(t).unwrap_or(SIZE);
+            let (class, sized) = self.cell_class(t, sized);
             if let Some(vol) = self.vol.as_mut() {
-                vol.queues[class].push_back((t, tv));
+                vol.queues[class.unwrap_or(SIZE)].push_back((t, tv, sized));
             }
         }
     }
