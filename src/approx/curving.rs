@@ -12,6 +12,8 @@ pub(super) struct OnInputSurface<'a> {
     pub patch_of: &'a [u32],
     pub curves: &'a FeatureCurves,
     pub vertex_slide: &'a [Slide],
+    /// Vertices on a span across a hole (`--repair`): no surface to curve onto there.
+    pub on_span: &'a [bool],
     /// The output boundary's feature edges, as (smaller, larger) vertex pairs.
     pub feature_edges: FxHashSet<(u32, u32)>,
 }
@@ -64,6 +66,10 @@ impl OnInputSurface<'_> {
 
 impl crate::quadratic::BoundaryCurving for OnInputSurface<'_> {
     fn curve(&self, a: u32, b: u32, mid: DVec3, triangles: &[u32]) -> Option<DVec3> {
+        let spans = |v: u32| self.on_span.get(v as usize).copied().unwrap_or(false);
+        if spans(a) || spans(b) {
+            return None;
+        }
         let feature = triangles.len() != 2 || self.feature_edges.contains(&(a.min(b), a.max(b)));
         if feature {
             self.onto_curve(a, b, mid)

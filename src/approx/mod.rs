@@ -99,6 +99,9 @@ pub struct Remeshed {
     /// Per vertex of `boundary`: where the improvement may slide it (none at corners and in
     /// small corners' balls).
     pub vertex_slide: Vec<Slide>,
+    /// Per vertex of `boundary`: whether it lies on a span across a hole of a repaired input
+    /// (where the surface is virtual: edges there stay straight in ten-node tets).
+    pub on_span: Vec<bool>,
     /// The feature curves (`Slide::Curve` indexes them).
     pub curves: FeatureCurves,
     pub stop_reason: Option<String>,
@@ -154,6 +157,7 @@ pub fn mesh(
             patch_of: &remeshed.features.patch_of,
             curves: &remeshed.curves,
             vertex_slide: &remeshed.vertex_slide,
+            on_span: &remeshed.on_span,
             feature_edges: remeshed
                 .feature_edges
                 .iter()
@@ -393,6 +397,11 @@ pub fn remesh(
         .map(|c| (c.point, c.protect_radius))
         .collect();
     let (small_corner_vertices, vertex_slide) = slides(&b, &curves);
+    let on_span = b
+        .loc
+        .iter()
+        .map(|l| matches!(l, restricted::Loc::Span))
+        .collect();
     let input_samples = b
         .input_samples
         .take()
@@ -407,6 +416,7 @@ pub fn remesh(
         input_samples,
         small_corner_vertices,
         vertex_slide,
+        on_span,
         input_volume,
         region_attributes,
         input_regions,
