@@ -42,6 +42,7 @@ pub mod tetgen;
 mod text;
 pub mod vtu;
 pub mod vtu_binary;
+pub mod xdmf;
 
 #[cfg(test)]
 pub(crate) mod tests;
@@ -95,7 +96,7 @@ pub fn is_surface_file(path: &Path) -> bool {
 pub const MESH_EXTENSIONS: &[&str] = &["vtu", "mesh", "msh", "node", "ele", "face"];
 
 /// Extensions accepted by [`write_mesh`]: [`MESH_EXTENSIONS`] and Abaqus `.inp` (written only).
-pub const WRITE_EXTENSIONS: &[&str] = &["vtu", "mesh", "msh", "node", "ele", "face", "inp"];
+pub const WRITE_EXTENSIONS: &[&str] = &["vtu", "mesh", "msh", "node", "ele", "face", "inp", "xdmf"];
 
 /// The lower-cased extension of `path`, or an error listing the supported ones.
 fn extension(path: &Path, supported: &[&str], what: &str) -> Result<String, IoError> {
@@ -153,6 +154,7 @@ pub fn write_mesh(path: &Path, mesh: &TetMesh, cell_fields: &[CellField]) -> Res
         "mesh" => medit::write_medit(path, mesh),
         "msh" => gmsh::write_msh(path, mesh),
         "inp" => abaqus::write_inp(path, mesh),
+        "xdmf" => xdmf::write_xdmf(path, mesh, None),
         _ => tetgen::write_tetgen(path, mesh),
     }
 }
@@ -183,6 +185,14 @@ pub fn write_output(
 ) -> Result<(), IoError> {
     match quadratic {
         None => write_mesh_in(path, mesh, cell_fields, binary),
+        Some(q)
+            if path
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("xdmf")) =>
+        {
+            text::check_mesh(mesh, &[]).map_err(|e| text::with_path(e, path))?;
+            xdmf::write_xdmf(path, mesh, Some(q))
+        }
         Some(_) => Err(IoError {
             path: path.display().to_string(),
             line: None,

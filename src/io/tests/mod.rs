@@ -5,6 +5,8 @@ mod fuzz;
 mod models;
 mod roundtrip;
 mod surface;
+#[cfg(feature = "hdf5")]
+mod xdmf;
 
 use std::path::{Path, PathBuf};
 
