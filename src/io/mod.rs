@@ -47,6 +47,7 @@ pub mod tetgen;
 mod text;
 pub mod vtu;
 pub mod vtu_binary;
+pub mod xdmf;
 
 #[cfg(test)]
 pub(crate) mod tests;
@@ -100,7 +101,7 @@ pub fn is_surface_file(path: &Path) -> bool {
 pub const MESH_EXTENSIONS: &[&str] = &["vtu", "mesh", "msh", "node", "ele", "face"];
 
 /// Extensions accepted by [`write_mesh`]: [`MESH_EXTENSIONS`] and Abaqus `.inp` (written only).
-pub const WRITE_EXTENSIONS: &[&str] = &["vtu", "mesh", "msh", "node", "ele", "face", "inp"];
+pub const WRITE_EXTENSIONS: &[&str] = &["vtu", "mesh", "msh", "node", "ele", "face", "inp", "xdmf"];
 
 /// The lower-cased extension of `path`, or an error listing the supported ones.
 fn extension(path: &Path, supported: &[&str], what: &str) -> Result<String, IoError> {
@@ -158,6 +159,7 @@ pub fn write_mesh(path: &Path, mesh: &TetMesh, cell_fields: &[CellField]) -> Res
         "mesh" => medit::write_medit(path, mesh),
         "msh" => gmsh::write_msh(path, mesh),
         "inp" => abaqus::write_inp(path, mesh),
+        "xdmf" => xdmf::write_xdmf(path, mesh, None),
         _ => tetgen::write_tetgen(path, mesh),
     }
 }
@@ -211,6 +213,7 @@ pub fn write_output(
         "msh" => gmsh::write_msh_quadratic(path, mesh, q),
         "mesh" => medit::write_medit_quadratic(path, mesh, q),
         "inp" => abaqus::write_inp_quadratic(path, mesh, q),
+        "xdmf" => xdmf::write_xdmf(path, mesh, Some(q)),
         _ => tetgen::write_tetgen_quadratic(path, mesh, q),
     }
 }

@@ -6,6 +6,8 @@ mod models;
 mod quadratic;
 mod roundtrip;
 mod surface;
+#[cfg(feature = "hdf5")]
+mod xdmf;
 
 use std::path::{Path, PathBuf};
 
