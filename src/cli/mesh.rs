@@ -312,15 +312,30 @@ fn finish(
     if let Some(q) = &report.quadratic {
         println!("{}", quadratic_table(q));
     }
-    if let Some(path) = stats_json {
-        let json = serde_json::to_string_pretty(report).map_err(|e| e.to_string())?;
-        std::fs::write(path, json).map_err(|e| format!("{}: {e}", path.display()))?;
-    }
     // Every tet measured once, for the .vtu's cell data and the quality table.
     let per_tet = slivermesh::quality::per_tet(mesh).ok();
     if let Some(path) = output {
         write_with_quality(path, written, per_tet.as_deref())?;
         println!("wrote {}", path.display());
+    }
+    // After writing, so that the peak covers the whole run.
+    let peak = super::rss::peak_rss_bytes();
+    if let Some(bytes) = peak {
+        println!(
+            "peak memory: {:.1} MB, {:.0} bytes a tet",
+            bytes as f64 / 1e6,
+            bytes as f64 / mesh.tets.len().max(1) as f64
+        );
+    }
+    if let Some(path) = stats_json {
+        let mut json = serde_json::to_value(report).map_err(|e| e.to_string())?;
+        if let (Some(bytes), Some(fields)) = (peak, json.as_object_mut()) {
+            let per_tet = bytes as f64 / mesh.tets.len().max(1) as f64;
+            fields.insert("peak_rss_mb".into(), (bytes as f64 / 1e6).into());
+            fields.insert("bytes_per_tet".into(), per_tet.into());
+        }
+        let text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())?;
+        std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))?;
     }
     // Measured on the mesh as written, the table `slivermesh quality` prints for that file.
     let name = output.map_or("the output mesh".to_string(), |p| p.display().to_string());
