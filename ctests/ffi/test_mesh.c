@@ -281,6 +281,54 @@ static void test_bad_spacing_inside(void) {
     sm_destroy(m);
 }
 
+/* Ten-node tets from C: "order" 2, then every node id in range, the corners as sm_get_tets
+ * gives them, and (keep mode: planar facets) each edge node at its edge's midpoint. */
+static void test_ten_node_tets(void) {
+    static const int edges[6][2] = {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {1, 3}, {2, 3}};
+    sm_mesher *m = make_cube();
+    size_t nv, nt, nn, i;
+    int e, k;
+    double *xyz;
+    uint32_t *tets, *tets10;
+    sm_status s;
+
+    CHECK_STATUS(m, sm_set_spacing_const(m, 0.35), SM_OK);
+    CHECK_STATUS(m, sm_set_param(m, "order", 2), SM_OK);
+    CHECK_STATUS(m, sm_set_param(m, "order", 3), SM_ERR_INVALID_ARGUMENT);
+    s = sm_refine(m);
+    if (mesh_pending(m, s)) {
+        g_pending = 1;
+        sm_destroy(m);
+        return;
+    }
+    CHECK_STATUS(m, s, SM_OK);
+    nv = sm_num_vertices(m);
+    nt = sm_num_tets(m);
+    nn = sm_num_nodes(m);
+    printf("ten-node cube: %zu vertices, %zu nodes, %zu tets\n", nv, nn, nt);
+    CHECK(nn > nv);
+    xyz = (double *)malloc(3 * nn * sizeof *xyz);
+    tets = (uint32_t *)malloc(4 * nt * sizeof *tets);
+    tets10 = (uint32_t *)malloc(10 * nt * sizeof *tets10);
+    CHECK_STATUS(m, sm_get_nodes(m, xyz, nn), SM_OK);
+    CHECK_STATUS(m, sm_get_tets(m, tets, NULL, nt), SM_OK);
+    CHECK_STATUS(m, sm_get_tets10(m, tets10, nt), SM_OK);
+    for (i = 0; i < nt; i++) {
+        const uint32_t *t = tets10 + 10 * i;
+        CHECK(memcmp(t, tets + 4 * i, 4 * sizeof *t) == 0);
+        for (e = 0; e < 6; e++) {
+            const double *a = xyz + 3 * t[edges[e][0]], *b = xyz + 3 * t[edges[e][1]];
+            CHECK(t[4 + e] >= nv && t[4 + e] < nn);
+            for (k = 0; k < 3; k++) CHECK(fabs(xyz[3 * t[4 + e] + k] - 0.5 * (a[k] + b[k])) < 1e-12);
+        }
+    }
+    CHECK_STATUS(m, sm_write(m, "ctest_cube_order2.msh"), SM_OK);
+    free(xyz);
+    free(tets);
+    free(tets10);
+    sm_destroy(m);
+}
+
 static void test_cancel_mid_run(void) {
     sm_mesher *m = make_cube();
     int calls = 0;
@@ -305,6 +353,7 @@ int main(void) {
     test_non_planar_facet();
     test_bad_spacing_inside();
     test_cancel_mid_run();
+    test_ten_node_tets();
     if (g_failures == 0 && g_pending) {
         printf("test_mesh: skipped parts wait on refine::mesh\n");
         return SKIP_CODE;
