@@ -183,6 +183,16 @@ module slivermesh
       integer(c_int32_t) :: s
     end function sm_set_region_size
 
+    !> Spacing at most h near the input facets of marker id, growing away as
+    !> h + 0.5 * (distance - h) (h > 0; an id no input facet has fails sm_refine).
+    function sm_set_marker_size(m, id, h) bind(C, name="sm_set_marker_size") result(s)
+      import :: c_ptr, c_double, c_int32_t
+      type(c_ptr), value :: m
+      integer(c_int32_t), value :: id
+      real(c_double), value :: h
+      integer(c_int32_t) :: s
+    end function sm_set_marker_size
+
     function sm_set_param_c(m, name, value) bind(C, name="sm_set_param") result(s)
       import :: c_ptr, c_char, c_double, c_int32_t
       type(c_ptr), value :: m
@@ -359,7 +369,8 @@ module slivermesh
 
   public :: sm_create, sm_destroy, sm_add_vertices, sm_add_facet, sm_add_facet_hole, &
             sm_add_hole, sm_add_region, sm_set_spacing_cb, sm_set_spacing_batch_cb, &
-            sm_set_spacing_const, sm_set_spacing_mesh, sm_set_region_size, sm_set_param_c, sm_get_param_c, sm_set_progress_cb, &
+            sm_set_spacing_const, sm_set_spacing_mesh, sm_set_region_size, sm_set_marker_size, &
+            sm_set_param_c, sm_get_param_c, sm_set_progress_cb, &
             sm_refine, sm_num_vertices, sm_num_tets, sm_num_boundary_faces, sm_get_vertices, &
             sm_get_tets, sm_get_boundary_faces, sm_get_quality, sm_num_nodes, sm_get_nodes, &
             sm_get_tets10, sm_num_regions, sm_get_regions, &

@@ -417,6 +417,19 @@ sm_status sm_set_spacing_batch_cb(sm_mesher *m, sm_spacing_batch_fn f, void *use
 sm_status sm_set_region_size(sm_mesher *m, int32_t id, double h);
 
 /**
+ * Limits the spacing near the input facets of boundary marker `id` (`h` finite and positive;
+ * `SM_ERR_INVALID_ARGUMENT` otherwise): within a distance `h` of them the spacing is at most
+ * `h`, farther away at most `h + 0.5 * (distance - h)`, the smaller of that and the spacing
+ * there (CLI `--marker-size ID:H`). Again for the same `id`, the new `h` replaces the old. An
+ * `id` no input facet has makes `sm_refine` fail with `SM_ERR_INVALID_INPUT`, the message
+ * naming it and listing the input's markers.
+ *
+ * # Safety
+ * `m` is NULL or a live handle.
+ */
+sm_status sm_set_marker_size(sm_mesher *m, int32_t id, double h);
+
+/**
  * Uses a size field on a background tet mesh as the spacing (adaptive loops: the field computed
  * on the previous mesh): `n_vertices` points `xyz` (3 doubles each), `n_tets` tets `tets` (4
  * 0-based vertex ids each) and one value per vertex (finite, > 0). The spacing at a point is the

@@ -259,6 +259,26 @@ impl Mesher {
         Ok(self.changed())
     }
 
+    /// Limits the spacing near the input facets of boundary marker `id` (`h` finite and
+    /// positive): within a distance `h` of them the spacing is at most `h`, farther away at
+    /// most `h + MARKER_GRADING * (distance - h)` ([`crate::refine::MARKER_GRADING`], 0.5),
+    /// the smaller of that and the spacing there (CLI `--marker-size ID:H`). Given again for
+    /// the same id, the new `h` replaces the old. An id no input facet has fails
+    /// [`Mesher::refine`], naming the id and listing the input's markers.
+    pub fn set_marker_size(&mut self, id: i32, h: f64) -> Result<&mut Self, Error> {
+        if !valid_value(h) {
+            return invalid(format!(
+                "marker size for marker {id}: h = {h} must be finite and > 0"
+            ));
+        }
+        let sizes = &mut self.params.marker_sizes;
+        match sizes.iter_mut().find(|(i, _)| *i == id) {
+            Some(entry) => entry.1 = h,
+            None => sizes.push((id, h)),
+        }
+        Ok(self.changed())
+    }
+
     /// Called with (fraction done, vertex count), once with 0 before any work and then as the
     /// refiner reports; returning `false` cancels the run ([`MeshError::Cancelled`]).
     pub fn set_progress<F: FnMut(f64, usize) -> bool + Send + 'static>(

@@ -25,8 +25,8 @@ pub use curves::SMALL_CORNER_DEG;
 use crate::mesh::{QuadraticNodes, TetMesh};
 use crate::plc::{Facet, PlcInput};
 use crate::refine::{
-    AutoSpacing, ConstantSpacing, MeshError, Params, Progress, Report, Spacing,
-    DEFAULT_SURFACE_DISTANCE_FRACTION,
+    AutoSpacing, ConstantSpacing, MarkerCapped, MarkerCaps, MeshError, Params, Progress, Report,
+    Spacing, DEFAULT_SURFACE_DISTANCE_FRACTION,
 };
 use crate::surface::features::{FeatureParams, Features};
 use crate::surface::oracle::SurfaceOracle;
@@ -106,6 +106,8 @@ pub struct Remeshed {
     pub curves: FeatureCurves,
     pub stop_reason: Option<String>,
     pub seconds: f64,
+    /// The caps of `Params::marker_sizes` on the input's triangles (None without any).
+    pub marker_caps: Option<MarkerCaps>,
 }
 
 /// Meshes the domain bounded by the surface `input` describes (see the module comment).
@@ -132,6 +134,14 @@ pub fn mesh(
         (Some(s), _) => s,
         (None, Some(s)) => s,
         (None, None) => &default_spacing,
+    };
+    let capped = MarkerCapped {
+        inner: f,
+        caps: remeshed.marker_caps.as_ref(),
+    };
+    let f: &dyn Spacing = match remeshed.marker_caps {
+        Some(_) => &capped,
+        None => f,
     };
     let measure_final = |mesh: &TetMesh, report: &mut Report| {
         measure_volume(mesh, f, params, &remeshed.small_corners, report)
@@ -345,6 +355,18 @@ pub fn remesh(
     let diagonal = surface.bbox_diagonal();
     let default_spacing = ConstantSpacing(DEFAULT_SPACING_FRACTION * diagonal);
     let f: &dyn Spacing = spacing.unwrap_or(&default_spacing);
+    // Per-marker sizes cap the spacing next to the input triangles of each marker given
+    // (whether or not the markers survive as the output's labels), the surface's and, through
+    // `SurfaceMesher::set_marker_caps`, the cells' automatic one.
+    let marker_caps = MarkerCaps::new(&surface, &params.marker_sizes)?;
+    let capped = MarkerCapped {
+        inner: f,
+        caps: marker_caps.as_ref(),
+    };
+    let f: &dyn Spacing = match marker_caps {
+        Some(_) => &capped,
+        None => f,
+    };
     // A bad spacing value keeps every crease here; the surface mesher reports it.
     let (features, noise) = Features::detect_denoised(
         &surface,
@@ -389,6 +411,7 @@ pub fn remesh(
         &source.region_attributes(),
         &params.region_sizes,
     )?);
+    mesher.set_marker_caps(marker_caps.as_ref());
     let (mut b, volume) = mesher.run_with_volume(crit, progress)?;
 
     let boundary = boundary_plc(input, &b, &surface, &features);
@@ -413,6 +436,7 @@ pub fn remesh(
     );
     let (repaired, repair_counts) = source.into_repaired();
     let remeshed = Remeshed {
+        marker_caps,
         input_samples,
         small_corner_vertices,
         vertex_slide,

@@ -33,7 +33,7 @@ use crate::delaunay::tables::FACE;
 use crate::delaunay::{Cavity, Delaunay, Inserted, Probe, INFINITE};
 use crate::geom::tri_circumcenter;
 use crate::refine::outcome::{BoundaryKind, Outcome, Refusal};
-use crate::refine::{MeshError, Spacing, SPACING_BATCH};
+use crate::refine::{MarkerCaps, MeshError, Spacing, SPACING_BATCH};
 use crate::surface::oracle::{Crossing, SurfaceOracle};
 use crate::surface::repair::{Repaired, HIDDEN};
 use crate::surface::thickness::Thickness;
@@ -221,6 +221,9 @@ pub struct SurfaceMesher<'a> {
     mended: FxHashSet<[u64; 3]>,
     /// Per region number the most spacing its cells get (`Params::region_sizes`; empty: none).
     region_caps: Vec<f64>,
+    /// The caps of `Params::marker_sizes`, applied to the cells' automatic spacing (`spacing`
+    /// holds them already).
+    marker_caps: Option<&'a MarkerCaps>,
 }
 
 /// The surface spacing's bound by the input's thickness, per input triangle.
@@ -319,6 +322,7 @@ impl<'a> SurfaceMesher<'a> {
             input_samples: std::cell::OnceCell::new(),
             mended: FxHashSet::default(),
             region_caps: vec![],
+            marker_caps: None,
             thin: thickness.map(|t| ThinBound {
                 per_triangle: t.per_triangle(surface),
                 scale: criteria.thickness_spacing,
@@ -360,6 +364,12 @@ impl<'a> SurfaceMesher<'a> {
     /// Caps the cells' spacing per region number (see `approx::region_caps`).
     pub fn set_region_caps(&mut self, caps: Vec<f64>) {
         self.region_caps = caps;
+    }
+
+    /// Caps the cells' automatic spacing by marker sizes (`spacing` must be capped by the
+    /// same: the surface and a caller's cell spacing read it).
+    pub fn set_marker_caps(&mut self, caps: Option<&'a MarkerCaps>) {
+        self.marker_caps = caps;
     }
 
     /// The surface spacing at `p`: the caller's, bounded by the thickness of the input

@@ -34,6 +34,12 @@ pub struct MeshOptions {
     #[arg(long = "region-size", value_name = "ID:H", value_parser = parse_id_size,
           allow_hyphen_values = true)]
     pub region_size: Vec<(i32, f64)>,
+    /// Maximum size H at the boundary facets of marker ID (repeatable): the spacing is at
+    /// most H within a distance H of them and grows away as H + 0.5 x (distance - H), the
+    /// smaller of that and the spacing (automatic, --size or --size-field).
+    #[arg(long = "marker-size", value_name = "ID:H", value_parser = parse_id_size,
+          allow_hyphen_values = true)]
+    pub marker_size: Vec<(i32, f64)>,
     /// Radius-edge bound rho0 (default 2).
     #[arg(long, value_name = "R")]
     pub rho: Option<f64>,
@@ -162,11 +168,12 @@ impl MeshOptions {
             p.small_angle_reach = v;
         }
         p.region_sizes = self.region_size.clone();
+        p.marker_sizes = self.marker_size.clone();
         p
     }
 }
 
-/// `ID:H` of `--region-size`: an integer id and a size, finite and > 0.
+/// `ID:H` of `--region-size` and `--marker-size`: an integer id and a size, finite and > 0.
 fn parse_id_size(s: &str) -> Result<(i32, f64), String> {
     let (id, h) = s
         .split_once(':')

@@ -593,6 +593,46 @@ fn cube_through_the_c_abi() {
     }
 }
 
+/// `sm_set_marker_size`: `h` is checked at once, the marker at `sm_refine` (named, with the
+/// input's markers); a valid one refines the faces of that marker: with a constant spacing of
+/// 0.5 and marker 3 (y = 0) capped at 0.1, that face gets many times the triangles of the
+/// opposite one (marker 4, y = 1).
+#[test]
+fn marker_size_through_the_c_abi() {
+    // SAFETY: a NULL handle is allowed; the others are live, buffers sized from the counts.
+    unsafe {
+        assert_eq!(sm_set_marker_size(null_mut(), 1, 0.1), SM_ERR_NULL);
+        let h = cube();
+        assert_eq!(sm_set_marker_size(h.0, 3, 0.0), SM_ERR_INVALID_ARGUMENT);
+        assert!(last_error(&h).contains("marker 3"), "{}", last_error(&h));
+        assert_eq!(
+            sm_set_marker_size(h.0, 3, f64::INFINITY),
+            SM_ERR_INVALID_ARGUMENT
+        );
+        assert_eq!(sm_set_marker_size(h.0, 9, 0.1), SM_OK);
+        assert_eq!(sm_refine(h.0), SM_ERR_INVALID_INPUT);
+        let e = last_error(&h);
+        assert!(
+            e.contains("marker 9") && e.contains("its markers: 1-6"),
+            "{e}"
+        );
+
+        let h = cube();
+        assert_eq!(sm_set_spacing_const(h.0, 0.5), SM_OK);
+        assert_eq!(sm_set_marker_size(h.0, 3, 0.1), SM_OK);
+        assert_eq!(sm_refine(h.0), SM_OK, "{}", last_error(&h));
+        let n = sm_num_boundary_faces(h.0);
+        let mut tris = vec![0u32; 3 * n];
+        let mut markers = vec![0i32; n];
+        assert_eq!(
+            sm_get_boundary_faces(h.0, tris.as_mut_ptr(), markers.as_mut_ptr(), n),
+            SM_OK
+        );
+        let count = |m: i32| markers.iter().filter(|&&k| k == m).count();
+        assert!(count(3) > 10 * count(4), "{} vs {}", count(3), count(4));
+    }
+}
+
 /// A size field on a background mesh of the cube (six tets around its diagonal), varying 6x
 /// along x: the tets near x = 0 come out smaller than those near x = 1; a bad value is named.
 #[test]

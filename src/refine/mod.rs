@@ -9,6 +9,7 @@ mod domain;
 pub mod existing;
 pub(crate) mod levels;
 mod mark;
+mod marker_size;
 pub(crate) mod outcome;
 mod output;
 mod plc_level;
@@ -18,6 +19,7 @@ pub mod report;
 mod spacing;
 
 pub(crate) use mark::unknown_region;
+pub use marker_size::{MarkerCapped, MarkerCaps, MARKER_GRADING};
 pub use outcome::Refusals;
 pub use quality::SPACING_BATCH;
 pub use spacing::AutoSpacing;
@@ -89,6 +91,11 @@ pub struct Params {
     /// spacing at most H (the smaller of it and the spacing's value). Each H finite and > 0;
     /// an ID the input does not have is an error. Not a parameter by name.
     pub region_sizes: Vec<(i32, f64)>,
+    /// Maximum sizes per boundary marker (`--marker-size ID:H`): the spacing is at most
+    /// H + [`MARKER_GRADING`] x max(0, d - H), d the distance to the input facets of marker ID
+    /// (the smaller of it and the spacing's value; `MarkerCaps`). Each H finite and > 0; an
+    /// ID no input facet has is an error. Not a parameter by name.
+    pub marker_sizes: Vec<(i32, f64)>,
 }
 
 /// Default improvement target (degrees) in keep mode: every acute-free model reaches 25.
@@ -134,6 +141,7 @@ impl Default for Params {
             repair: false,
             order: 1,
             region_sizes: Vec::new(),
+            marker_sizes: Vec::new(),
         }
     }
 }
@@ -221,6 +229,13 @@ impl Params {
             if !(h.is_finite() && h > 0.0) {
                 return Err(format!(
                     "region size for region {id}: h = {h} must be finite and > 0"
+                ));
+            }
+        }
+        for &(id, h) in &self.marker_sizes {
+            if !(h.is_finite() && h > 0.0) {
+                return Err(format!(
+                    "marker size for marker {id}: h = {h} must be finite and > 0"
                 ));
             }
         }
@@ -508,6 +523,12 @@ fn mesh_domain(
     let start = std::time::Instant::now();
     params.check().map_err(MeshError::InvalidInput)?;
     let plc = crate::plc::validate(input).map_err(|e| MeshError::InvalidInput(e.to_string()))?;
+    let marker_caps = if params.marker_sizes.is_empty() {
+        None
+    } else {
+        let surface = crate::surface::InputSurface::from_plc(&plc);
+        MarkerCaps::new(&surface, &params.marker_sizes)?
+    };
     let mut dom = domain::Domain::new(input, &plc)?;
     match small_angles {
         SmallAngles::Input => dom.set_input_angles(&plc, params.small_angle_reach),
@@ -527,6 +548,17 @@ fn mesh_domain(
             auto = spacing::AutoSpacing::from_boundary(&dom);
             &auto
         }
+    };
+    let capped;
+    let spacing: &dyn Spacing = match &marker_caps {
+        Some(caps) => {
+            capped = MarkerCapped {
+                inner: spacing,
+                caps: Some(caps),
+            };
+            &capped
+        }
+        None => spacing,
     };
     let mut passes = Passes::default();
     if params.refine {

@@ -19,7 +19,7 @@ use crate::geom::screen::{shortest_edge_sq, sliver_measures};
 use crate::refine::levels::{
     pick_in_ball, Conflict, FacetLevel, GiveUp, Picker, Request, SliverBounds,
 };
-use crate::refine::{AutoSpacing, Spacing};
+use crate::refine::{AutoSpacing, MarkerCapped, Spacing};
 use glam::DVec3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -216,11 +216,18 @@ impl SurfaceMesher<'_> {
         }
     }
 
-    /// The spacing cells are sized by: the automatic one, or the caller's.
-    fn cell_spacing(&self) -> &dyn Spacing {
+    /// The spacing cells are sized by: the automatic one capped by the marker sizes, or the
+    /// caller's (capped already).
+    fn cell_spacing(&self) -> MarkerCapped<'_> {
         match self.vol.as_ref().and_then(|v| v.spacing.as_ref()) {
-            Some(s) => s,
-            None => self.spacing,
+            Some(s) => MarkerCapped {
+                inner: s,
+                caps: self.marker_caps,
+            },
+            None => MarkerCapped {
+                inner: self.spacing,
+                caps: None,
+            },
         }
     }
 
