@@ -16,6 +16,7 @@
 mod error;
 mod mesher;
 mod output;
+pub mod param_table;
 pub mod params;
 mod spacing;
 

@@ -49,10 +49,11 @@ pub struct MeshOptions {
     /// Smallest dihedral angle allowed, in degrees (default 18).
     #[arg(long, value_name = "DEG")]
     pub min_dihedral: Option<f64>,
-    /// Random seed (same input, parameters and seed: identical output).
+    /// Random seed (same input, parameters and seed: identical output; default 1).
     #[arg(long, value_name = "N")]
     pub seed: Option<u64>,
-    /// Stop refining at this many vertices (the report then says complete: false).
+    /// Stop refining at this many vertices (the report then says complete: false; default
+    /// 10000000).
     #[arg(long, value_name = "N")]
     pub max_vertices: Option<usize>,
     /// Reach of a small input angle's influence along its segments and facets, in
@@ -578,10 +579,25 @@ mod tests {
                 .collect();
             number.trim_end_matches('.').parse().unwrap()
         };
-        assert_eq!(stated("rho"), d.rho0);
-        assert_eq!(stated("sigma"), d.sigma0);
-        assert_eq!(stated("min-dihedral"), d.min_dihedral);
-        assert_eq!(stated("feature-angle"), d.feature_angle);
+        // Each option against the library's one table of parameters.
+        for (long, name) in [
+            ("rho", "rho0"),
+            ("sigma", "sigma0"),
+            ("min-dihedral", "min_dihedral"),
+            ("feature-angle", "feature_angle"),
+            ("seed", "seed"),
+            ("max-vertices", "max_vertices"),
+        ] {
+            let spec = slivermesh::api::param_table::spec(name).unwrap();
+            assert_eq!(stated(long), spec.default, "--{long} vs {name}");
+        }
+        assert_eq!(d.order as f64, {
+            let arg = cmd.get_arguments().find(|a| a.get_long() == Some("order"));
+            arg.and_then(|a| a.get_default_values().first())
+                .and_then(|v| v.to_str())
+                .and_then(|v| v.parse::<f64>().ok())
+                .expect("--order's default")
+        });
     }
 
     #[test]
