@@ -174,6 +174,23 @@ module slivermesh
       integer(c_int32_t) :: s
     end function sm_set_spacing_mesh
 
+    !> An existing mesh whose slivers sm_refine removes (keep mode): xyz(3, n_vertices),
+    !> tets(4, n_tets) 0-based with regions(n_tets), tris(3, n_tris) with markers(n_tris).
+    function sm_set_existing_mesh(m, xyz, n_vertices, tets, regions, n_tets, tris, markers, &
+        n_tris) bind(C, name="sm_set_existing_mesh") result(s)
+      import :: c_ptr, c_double, c_size_t, c_int32_t
+      type(c_ptr), value :: m
+      real(c_double), intent(in) :: xyz(*)
+      integer(c_size_t), value :: n_vertices
+      integer(c_int32_t), intent(in) :: tets(*)
+      integer(c_int32_t), intent(in) :: regions(*)
+      integer(c_size_t), value :: n_tets
+      integer(c_int32_t), intent(in) :: tris(*)
+      integer(c_int32_t), intent(in) :: markers(*)
+      integer(c_size_t), value :: n_tris
+      integer(c_int32_t) :: s
+    end function sm_set_existing_mesh
+
     !> Spacing at most h in the region of attribute id (h > 0; an id the input lacks fails sm_refine).
     function sm_set_region_size(m, id, h) bind(C, name="sm_set_region_size") result(s)
       import :: c_ptr, c_double, c_int32_t
@@ -370,6 +387,7 @@ module slivermesh
   public :: sm_create, sm_destroy, sm_add_vertices, sm_add_facet, sm_add_facet_hole, &
             sm_add_hole, sm_add_region, sm_set_spacing_cb, sm_set_spacing_batch_cb, &
             sm_set_spacing_const, sm_set_spacing_mesh, sm_set_region_size, sm_set_marker_size, &
+            sm_set_existing_mesh, &
             sm_set_param_c, sm_get_param_c, sm_set_progress_cb, &
             sm_refine, sm_num_vertices, sm_num_tets, sm_num_boundary_faces, sm_get_vertices, &
             sm_get_tets, sm_get_boundary_faces, sm_get_quality, sm_num_nodes, sm_get_nodes, &

@@ -450,6 +450,31 @@ sm_status sm_set_spacing_mesh(sm_mesher *m,
                               const double *values);
 
 /**
+ * Makes `sm_refine` remove the slivers of an existing tet mesh instead of meshing the domain
+ * (the CLI's `.mesh` input): `n_vertices` points `xyz` (3 doubles each), `n_tets` tets `tets` (4
+ * 0-based vertex ids each, positively oriented) with their region attributes `regions` (NULL:
+ * all 0), and `n_tris` boundary and interface triangles `tris` (3 ids each) with their markers
+ * `markers` (NULL: all 0). Its boundary is kept as it is (keep mode only), its tets refined and
+ * improved to the parameters' bounds; the spacing is the mesh's own. The arrays are copied.
+ * `SM_ERR_INVALID_ARGUMENT` names a non-finite vertex or an id beyond the vertices;
+ * `sm_refine` reports the rest (an open boundary, an inverted tet).
+ *
+ * # Safety
+ * `m` is NULL or a live handle; `xyz` points to `3 * n_vertices` doubles, `tets` to
+ * `4 * n_tets` ids, `regions` is NULL or points to `n_tets` ints, `tris` to `3 * n_tris` ids,
+ * `markers` is NULL or points to `n_tris` ints (an array may be NULL when its count is 0).
+ */
+sm_status sm_set_existing_mesh(sm_mesher *m,
+                               const double *xyz,
+                               size_t n_vertices,
+                               const uint32_t *tets,
+                               const int32_t *regions,
+                               size_t n_tets,
+                               const uint32_t *tris,
+                               const int32_t *markers,
+                               size_t n_tris);
+
+/**
  * Calls `f(fraction, n_vertices, user_data)` during `sm_refine` (once with 0 before any work);
  * a non-zero return cancels it with `SM_ERR_CANCELLED`. `f` == NULL removes the callback.
  *

@@ -40,3 +40,28 @@ pub fn mesh(
     report.measure_regions(&mesh);
     Ok((mesh, quadratic, report))
 }
+
+/// Removes the slivers of an existing mesh (`refine::existing`), keeping its boundary and
+/// interface triangles, holes and regions, then improves it with that boundary fixed (there is
+/// no facet description to slide on). With `params.order` 2, the mid-edge nodes at the
+/// midpoints. Keep mode only: an existing mesh's boundary is kept as it is.
+pub fn remove_slivers(
+    existing: &TetMesh,
+    params: &Params,
+) -> Result<(TetMesh, Option<QuadraticNodes>, Report), MeshError> {
+    if params.surface_mode == SurfaceMode::Approximate {
+        return Err(MeshError::InvalidInput(
+            "the approximate surface mode does not apply to an existing mesh: its boundary is \
+             kept as it is"
+                .into(),
+        ));
+    }
+    let (mesh, mut report) = refine::existing::remove_slivers(existing, params)?;
+    let mesh = crate::improve::finish(mesh, &mut report, None, params, None)?;
+    let quadratic = (params.order == 2).then(|| {
+        let (nodes, quadratic_report) = crate::quadratic::elevate(&mesh, None);
+        report.quadratic = Some(quadratic_report);
+        nodes
+    });
+    Ok((mesh, quadratic, report))
+}

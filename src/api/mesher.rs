@@ -42,6 +42,8 @@ pub type ProgressFn = Box<dyn FnMut(f64, usize) -> bool + Send>;
 #[derive(Default)]
 pub struct Mesher {
     input: PlcInput,
+    /// An existing mesh whose slivers `refine` removes instead of meshing `input`.
+    existing: Option<TetMesh>,
     params: Params,
     spacing: SpacingChoice,
     progress: Option<ProgressFn>,
@@ -52,6 +54,7 @@ impl std::fmt::Debug for Mesher {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Mesher")
             .field("input", &self.input)
+            .field("existing", &self.existing)
             .field("params", &self.params)
             .field("spacing", &self.spacing)
             .field("progress", &self.progress.as_ref().map(|_| ".."))
@@ -295,6 +298,53 @@ impl Mesher {
         self
     }
 
+    /// Makes `refine` remove the slivers of `mesh` instead of meshing the domain
+    /// (`pipeline::remove_slivers`): its boundary and interface triangles are kept with their
+    /// markers, its regions and holes too, and the tets between are refined and improved to
+    /// the parameters' bounds (keep mode only; the spacing is the mesh's own). Checks that every
+    /// vertex is finite and in range and every id names a vertex; `refine` checks the rest
+    /// (orientation, a closed boundary).
+    pub fn set_existing_mesh(&mut self, mesh: TetMesh) -> Result<&mut Self, Error> {
+        for (i, &p) in mesh.vertices.iter().enumerate() {
+            check_point(&format!("existing mesh vertex {i}"), p)?;
+        }
+        let n = mesh.vertices.len() as u64;
+        let bad_tet = mesh
+            .tets
+            .iter()
+            .position(|t| t.iter().any(|&v| v as u64 >= n));
+        if let Some(t) = bad_tet {
+            return invalid(format!(
+                "existing mesh tet {t} {:?} names a vertex beyond the {n} given",
+                mesh.tets[t]
+            ));
+        }
+        let bad_tri = mesh
+            .boundary
+            .iter()
+            .position(|t| t.iter().any(|&v| v as u64 >= n));
+        if let Some(t) = bad_tri {
+            return invalid(format!(
+                "existing mesh boundary triangle {t} {:?} names a vertex beyond the {n} given",
+                mesh.boundary[t]
+            ));
+        }
+        if mesh.tet_regions.len() != mesh.tets.len()
+            || mesh.boundary_markers.len() != mesh.boundary.len()
+        {
+            return invalid(format!(
+                "existing mesh: {} regions for {} tets, {} markers for {} boundary triangles",
+                mesh.tet_regions.len(),
+                mesh.tets.len(),
+                mesh.boundary_markers.len(),
+                mesh.boundary.len()
+            ));
+        }
+        self.existing = Some(mesh);
+        self.output = None;
+        Ok(self)
+    }
+
     /// Meshes the domain with the stored spacing and progress callback: `pipeline::mesh`, in the
     /// parameters' `surface_mode` (default keep), then the improvement pass (`improve`).
     pub fn refine(&mut self) -> Result<&Report, Error> {
@@ -342,6 +392,9 @@ impl Mesher {
         let result = (|| {
             if !relay(0.0, self.input.vertices.len()) {
                 return Err(MeshError::Cancelled);
+            }
+            if let Some(existing) = &self.existing {
+                return crate::pipeline::remove_slivers(existing, &self.params);
             }
             if let Some(c) = &checked {
                 c.precheck(&self.input.vertices)?;

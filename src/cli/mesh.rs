@@ -2,13 +2,12 @@
 
 use indicatif::{ProgressBar, ProgressStyle};
 use slivermesh::geom::TetQuality;
-use slivermesh::improve;
 use slivermesh::io::{self, ReadOptions};
 use slivermesh::mesh::{QuadraticNodes, TetMesh};
 use slivermesh::pipeline;
 use slivermesh::plc::{Facet, PlcInput, Region};
 use slivermesh::refine::{
-    self, ConstantSpacing, FnSpacing, Params, Report, Spacing, SurfaceMode, SurfaceReport,
+    ConstantSpacing, FnSpacing, Params, Report, Spacing, SurfaceMode, SurfaceReport,
 };
 use slivermesh::DVec3;
 use std::io::IsTerminal;
@@ -237,17 +236,7 @@ pub fn run_mesh(
             ));
         }
         let existing = io::read_mesh(input).map_err(|e| e.to_string())?;
-        let (mesh, mut report) =
-            refine::existing::remove_slivers(&existing, &params).map_err(|e| e.to_string())?;
-        // The existing mesh's boundary stays as it is (no facet description to move within).
-        let mesh =
-            improve::finish(mesh, &mut report, None, &params, None).map_err(|e| e.to_string())?;
-        let quadratic = (params.order == 2).then(|| {
-            let (nodes, quadratic_report) = slivermesh::quadratic::elevate(&mesh, None);
-            report.quadratic = Some(quadratic_report);
-            nodes
-        });
-        (mesh, quadratic, report)
+        pipeline::remove_slivers(&existing, &params).map_err(|e| e.to_string())?
     } else {
         let merge = !opts.no_merge && io::is_surface_file(input);
         let plc = io::read_plc(

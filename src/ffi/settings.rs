@@ -231,6 +231,69 @@ pub unsafe extern "C" fn sm_set_spacing_mesh(
     })
 }
 
+/// Makes `sm_refine` remove the slivers of an existing tet mesh instead of meshing the domain
+/// (the CLI's `.mesh` input): `n_vertices` points `xyz` (3 doubles each), `n_tets` tets `tets` (4
+/// 0-based vertex ids each, positively oriented) with their region attributes `regions` (NULL:
+/// all 0), and `n_tris` boundary and interface triangles `tris` (3 ids each) with their markers
+/// `markers` (NULL: all 0). Its boundary is kept as it is (keep mode only), its tets refined and
+/// improved to the parameters' bounds; the spacing is the mesh's own. The arrays are copied.
+/// `SM_ERR_INVALID_ARGUMENT` names a non-finite vertex or an id beyond the vertices;
+/// `sm_refine` reports the rest (an open boundary, an inverted tet).
+///
+/// # Safety
+/// `m` is NULL or a live handle; `xyz` points to `3 * n_vertices` doubles, `tets` to
+/// `4 * n_tets` ids, `regions` is NULL or points to `n_tets` ints, `tris` to `3 * n_tris` ids,
+/// `markers` is NULL or points to `n_tris` ints (an array may be NULL when its count is 0).
+#[no_mangle]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn sm_set_existing_mesh(
+    m: *mut sm_mesher,
+    xyz: *const f64,
+    n_vertices: usize,
+    tets: *const u32,
+    regions: *const i32,
+    n_tets: usize,
+    tris: *const u32,
+    markers: *const i32,
+    n_tris: usize,
+) -> sm_status {
+    // SAFETY: `m` is NULL or a live handle (contract above).
+    let handle = unsafe { m.as_ref() };
+    handle_call(handle, "sm_set_existing_mesh", |st| {
+        let xyz_len = scaled("xyz", n_vertices, 3)?;
+        let tets_len = scaled("tets", n_tets, 4)?;
+        let tris_len = scaled("tris", n_tris, 3)?;
+        // SAFETY: the pointers hold the counts the contract above says.
+        let (xyz, tets, tris) = unsafe {
+            (
+                input("xyz", xyz, xyz_len)?,
+                input("tets", tets, tets_len)?,
+                input("tris", tris, tris_len)?,
+            )
+        };
+        let labels = |p: *const i32, n: usize, what: &str| -> Result<Vec<i32>, FfiError> {
+            if p.is_null() {
+                Ok(vec![0; n])
+            } else {
+                // SAFETY: non-null, and holds `n` ints (contract above).
+                Ok(unsafe { input(what, p, n) }?.to_vec())
+            }
+        };
+        let mesh = crate::mesh::TetMesh {
+            vertices: xyz.chunks_exact(3).map(glam::DVec3::from_slice).collect(),
+            tets: tets
+                .chunks_exact(4)
+                .map(|t| [t[0], t[1], t[2], t[3]])
+                .collect(),
+            tet_regions: labels(regions, n_tets, "regions")?,
+            boundary: tris.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect(),
+            boundary_markers: labels(markers, n_tris, "markers")?,
+        };
+        st.mesher.set_existing_mesh(mesh)?;
+        Ok(())
+    })
+}
+
 /// Calls `f(fraction, n_vertices, user_data)` during `sm_refine` (once with 0 before any work);
 /// a non-zero return cancels it with `SM_ERR_CANCELLED`. `f` == NULL removes the callback.
 ///

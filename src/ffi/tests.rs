@@ -788,3 +788,88 @@ fn ten_node_tets_through_the_c_abi() {
         assert_eq!(mids.len(), nn - nv, "every node belongs to an edge");
     }
 }
+
+/// An existing mesh through the C ABI: the cube meshed without improvement, handed to a fresh
+/// mesher whose refine removes its slivers: the volume and the boundary stay, no tet is flat,
+/// and a bad id is named.
+#[test]
+fn existing_mesh_through_the_c_abi() {
+    let h = cube();
+    let improve = std::ffi::CString::new("improve").unwrap();
+    // SAFETY: live handles; buffers sized from the counts.
+    unsafe {
+        assert_eq!(sm_set_spacing_const(h.0, 0.3), SM_OK);
+        assert_eq!(sm_set_param(h.0, improve.as_ptr(), 0.0), SM_OK);
+        assert_eq!(sm_refine(h.0), SM_OK, "{}", last_error(&h));
+        let (nv, nt, nf) = (
+            sm_num_vertices(h.0),
+            sm_num_tets(h.0),
+            sm_num_boundary_faces(h.0),
+        );
+        let mut xyz = vec![0.0; 3 * nv];
+        let mut tets = vec![0u32; 4 * nt];
+        let mut tris = vec![0u32; 3 * nf];
+        let mut markers = vec![0i32; nf];
+        assert_eq!(sm_get_vertices(h.0, xyz.as_mut_ptr(), nv), SM_OK);
+        assert_eq!(sm_get_tets(h.0, tets.as_mut_ptr(), null_mut(), nt), SM_OK);
+        assert_eq!(
+            sm_get_boundary_faces(h.0, tris.as_mut_ptr(), markers.as_mut_ptr(), nf),
+            SM_OK
+        );
+
+        let e = new();
+        let mut bad = tets.clone();
+        bad[1] = nv as u32;
+        assert_eq!(
+            sm_set_existing_mesh(
+                e.0,
+                xyz.as_ptr(),
+                nv,
+                bad.as_ptr(),
+                null(),
+                nt,
+                tris.as_ptr(),
+                markers.as_ptr(),
+                nf
+            ),
+            SM_ERR_INVALID_ARGUMENT
+        );
+        assert!(last_error(&e).contains("tet 0"), "{}", last_error(&e));
+        assert_eq!(
+            sm_set_existing_mesh(
+                e.0,
+                xyz.as_ptr(),
+                nv,
+                tets.as_ptr(),
+                null(),
+                nt,
+                tris.as_ptr(),
+                markers.as_ptr(),
+                nf
+            ),
+            SM_OK
+        );
+        assert_eq!(sm_refine(e.0), SM_OK, "{}", last_error(&e));
+        let (nv2, nt2) = (sm_num_vertices(e.0), sm_num_tets(e.0));
+        let mut xyz2 = vec![0.0; 3 * nv2];
+        let mut tets2 = vec![0u32; 4 * nt2];
+        assert_eq!(sm_get_vertices(e.0, xyz2.as_mut_ptr(), nv2), SM_OK);
+        assert_eq!(sm_get_tets(e.0, tets2.as_mut_ptr(), null_mut(), nt2), SM_OK);
+        let p = |i: u32| DVec3::from_slice(&xyz2[3 * i as usize..]);
+        let volumes: Vec<f64> = tets2
+            .chunks_exact(4)
+            .map(|t| {
+                (p(t[1]) - p(t[0]))
+                    .cross(p(t[2]) - p(t[0]))
+                    .dot(p(t[3]) - p(t[0]))
+                    / 6.0
+            })
+            .collect();
+        assert!(volumes.iter().all(|&v| v > 0.0));
+        let volume: f64 = volumes.iter().sum();
+        assert!((volume - 1.0).abs() < 1e-9, "{volume}");
+        let mut q = std::mem::zeroed::<sm_quality>();
+        assert_eq!(sm_get_quality(e.0, &mut q), SM_OK);
+        assert!(q.min_dihedral_deg > 15.0, "{}", q.min_dihedral_deg);
+    }
+}
