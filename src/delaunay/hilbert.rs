@@ -54,6 +54,13 @@ pub fn hilbert_index(cell: [u32; 3], bits: u32) -> u64 {
     (spread3(x0) << 2) | (spread3(x1) << 1) | spread3(x2)
 }
 
+/// Morton (Z-order) index of a cell with 21-bit coordinates: bit b of x, y, z at bits 3b+2,
+/// 3b+1, 3b.
+#[inline]
+pub fn morton_index(cell: [u32; 3]) -> u64 {
+    (spread3(cell[0]) << 2) | (spread3(cell[1]) << 1) | spread3(cell[2])
+}
+
 /// Spreads the low 21 bits of `x` to every third bit.
 #[inline(always)]
 fn spread3(x: u32) -> u64 {

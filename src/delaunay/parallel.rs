@@ -3,9 +3,9 @@
 //! 2019, the HXT scheme), on std threads of a rayon pool. See docs/parallel.md.
 //!
 //! Each BRIO round ([`hilbert::brio_rounds`]) big enough is inserted in *phases*. A phase
-//! splits the points still to insert into T parts of equal size along a Hilbert curve over the
-//! whole bounding box (30-bit keys, the split points being quantiles of the keys shifted by a
-//! per-attempt offset), and gives every vertex (inserted or not) the part its key falls in.
+//! splits the points still to insert into T parts of equal size along a space-filling curve
+//! (Z-order) over the whole bounding box (later phases: slabs across the axis the points left
+//! spread most along), and gives every vertex (inserted or not) the part its key falls in.
 //! Thread i inserts the points of part i, in BRIO order, touching only
 //!
 //! - tets it *owns*: every finite vertex in part i (the vertex at infinity is in every part),
@@ -43,8 +43,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, AtomicU8, Ordering::Relaxed};
 
-/// Bits per axis of the partition keys (48-bit keys: fine enough for clustered points).
-const KEY_BITS: u32 = 16;
+/// Bits per axis of the partition keys (63-bit keys: fine enough for clustered points).
+const KEY_BITS: u32 = 21;
 /// A round is split among the threads when it has at least this many points per thread.
 const MIN_PHASE_POINTS_PER_THREAD: usize = 4096;
 /// A retry phase runs while this many points per thread are left.
@@ -133,9 +133,22 @@ impl<'a> Shared<'a> {
         }
     }
 
+    // Unchecked indexing on the hot paths, as in the serial kernel. Invariants: neighbour
+    // references of alive tets name existing slots, finite vertex ids of alive tets index the
+    // vertex arrays (checked in debug builds); a thread follows references only out of tets it
+    // owns or touches, whose records no other thread writes during the phase.
+
+    /// The record of slot `t`.
+    #[inline(always)]
+    fn rec(&self, t: u32) -> &AtomicTet {
+        debug_assert!((t as usize) < self.tets.len());
+        // SAFETY: see the invariants above.
+        unsafe { self.tets.get_unchecked(t as usize) }
+    }
+
     #[inline(always)]
     fn verts(&self, t: u32) -> [u32; 4] {
-        let a = &self.tets[t as usize].v;
+        let a = &self.rec(t).v;
         [
             a[0].load(Relaxed),
             a[1].load(Relaxed),
@@ -144,8 +157,12 @@ impl<'a> Shared<'a> {
         ]
     }
     #[inline(always)]
+    fn vert(&self, t: u32, i: usize) -> u32 {
+        self.rec(t).v[i].load(Relaxed)
+    }
+    #[inline(always)]
     fn nbrs(&self, t: u32) -> [u32; 4] {
-        let a = &self.tets[t as usize].n;
+        let a = &self.rec(t).n;
         [
             a[0].load(Relaxed),
             a[1].load(Relaxed),
@@ -155,15 +172,15 @@ impl<'a> Shared<'a> {
     }
     #[inline(always)]
     fn nbr(&self, t: u32, i: usize) -> u32 {
-        self.tets[t as usize].n[i].load(Relaxed)
+        self.rec(t).n[i].load(Relaxed)
     }
     #[inline(always)]
     fn set_nbr(&self, t: u32, i: usize, r: u32) {
-        self.tets[t as usize].n[i].store(r, Relaxed);
+        self.rec(t).n[i].store(r, Relaxed);
     }
     #[inline(always)]
     fn write(&self, t: u32, v: [u32; 4], n: [u32; 4]) {
-        let a = &self.tets[t as usize];
+        let a = self.rec(t);
         for k in 0..4 {
             a.v[k].store(v[k], Relaxed);
             a.n[k].store(n[k], Relaxed);
@@ -171,27 +188,39 @@ impl<'a> Shared<'a> {
     }
     #[inline(always)]
     fn kill(&self, t: u32) {
-        for x in &self.tets[t as usize].v {
+        for x in &self.rec(t).v {
             x.store(DEAD, Relaxed);
         }
     }
     #[inline(always)]
     fn mark(&self, t: u32) -> u8 {
-        self.mark[t as usize].load(Relaxed)
+        debug_assert!((t as usize) < self.mark.len());
+        // SAFETY: one mark per tet slot.
+        unsafe { self.mark.get_unchecked(t as usize) }.load(Relaxed)
     }
     #[inline(always)]
     fn set_mark(&self, t: u32, m: u8) {
-        self.mark[t as usize].store(m, Relaxed);
+        debug_assert!((t as usize) < self.mark.len());
+        // SAFETY: one mark per tet slot.
+        unsafe { self.mark.get_unchecked(t as usize) }.store(m, Relaxed);
     }
     #[inline(always)]
     fn point(&self, v: u32) -> DVec3 {
-        self.points[v as usize]
+        debug_assert!((v as usize) < self.points.len());
+        // SAFETY: see the invariants above (called with finite vertex ids of alive tets and
+        // with ids of points to insert).
+        unsafe { *self.points.get_unchecked(v as usize) }
     }
     /// Whether every finite vertex of `v` is in part `me`.
     #[inline(always)]
     fn owned(&self, v: [u32; 4], me: u8) -> bool {
-        v.iter()
-            .all(|&x| x == INFINITE || self.part[x as usize] == me)
+        v.iter().all(|&x| {
+            x == INFINITE || {
+                debug_assert!((x as usize) < self.part.len());
+                // SAFETY: `part` has one entry per vertex id; see the invariants above.
+                unsafe { *self.part.get_unchecked(x as usize) == me }
+            }
+        })
     }
 
     /// Perturbed in-sphere test of finite tet `v` against `p` of rank `rank`.
@@ -203,6 +232,20 @@ impl<'a> Shared<'a> {
             return s > 0.0;
         }
         insphere_tie(q, v.map(|i| self.rank[i as usize]), p, rank)
+    }
+
+    /// Hints the coordinates of vertex `v` (any id, `INFINITE` included) into the cache.
+    #[inline(always)]
+    fn prefetch_point(&self, v: u32) {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: a prefetch never faults and reads nothing (any address is allowed); the
+        // pointer arithmetic wraps, so it is defined for any id. SSE is baseline on x86_64.
+        unsafe {
+            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+            let ptr = self.points.as_ptr().wrapping_add(v as usize) as *const i8;
+            _mm_prefetch(ptr, _MM_HINT_T0);
+            _mm_prefetch(ptr.wrapping_add(16), _MM_HINT_T0);
+        }
     }
 
     /// Hints the records and marks of `t`'s neighbours into the cache.
@@ -256,12 +299,13 @@ struct Worker {
     duplicates: usize,
     alive: isize,
     ghosts: isize,
+    /// On-CPU seconds of its last phase (tracing only).
+    cpu: f64,
 }
 
 impl Worker {
-    fn run(&mut self, sh: &Shared) {
-        let sched0 = schedstat();
-        let wall0 = std::time::Instant::now();
+    fn run(&mut self, sh: &Shared, trace: bool) {
+        let cpu0 = if trace { on_cpu() } else { 0.0 };
         self.created.clear();
         self.deferred.clear();
         self.deferred_at.clear();
@@ -292,15 +336,8 @@ impl Worker {
         }
         self.todo = todo;
         self.todo.clear();
-        if std::env::var_os("SLIVERMESH_PAR_TRACE").is_some() {
-            let s = schedstat();
-            eprintln!(
-                "   worker {}: wall {:.3} run {:.3} wait {:.3}",
-                self.me,
-                wall0.elapsed().as_secs_f64(),
-                (s.0 - sched0.0) as f64 * 1e-9,
-                (s.1 - sched0.1) as f64 * 1e-9
-            );
+        if trace {
+            self.cpu = on_cpu() - cpu0;
         }
     }
 
@@ -452,6 +489,16 @@ impl Worker {
             let v = sh.verts(t);
             let nb = sh.nbrs(t);
             let finite = !has_infinite(v);
+            // The apex of each neighbour across a face (its only vertex off the face), its
+            // coordinates prefetched before the tests, as in the serial search.
+            let mut apex = [INFINITE; 4];
+            for (i, a) in apex.iter_mut().enumerate() {
+                if i != entry {
+                    let r = nb[i];
+                    *a = sh.vert(r >> 2, (r & 3) as usize);
+                    sh.prefetch_point(*a);
+                }
+            }
             let fan = finite.then(|| InsphereFan::new(v.map(|x| sh.point(x)), p));
             for (i, &r) in nb.iter().enumerate() {
                 if i == entry {
@@ -463,17 +510,15 @@ impl Worker {
                     continue;
                 }
                 if m != OUTSIDE {
-                    let nv = sh.verts(n);
-                    let apex = nv[(r & 3) as usize];
-                    let conflict = match (&fan, apex) {
+                    let conflict = match (&fan, apex[i]) {
                         (Some(fan), a) if a != INFINITE => {
                             let f = FACE[i];
                             match fan.across(f[0], f[1], f[2], sh.point(a), p) {
                                 Some(det) => det > 0.0,
-                                None => sh.finite_conflict(nv, p, rank),
+                                None => sh.finite_conflict(sh.verts(n), p, rank),
                             }
                         }
-                        _ => match self.conflict(sh, n, nv, t, p, rank) {
+                        _ => match self.conflict(sh, n, sh.verts(n), t, p, rank) {
                             Some(c) => c,
                             None => {
                                 ok = false;
@@ -482,7 +527,7 @@ impl Worker {
                         },
                     };
                     if conflict {
-                        if !sh.owned(nv, me) {
+                        if !sh.owned(sh.verts(n), me) {
                             ok = false;
                             break 'search;
                         }
@@ -590,8 +635,13 @@ impl Delaunay {
                 (dt, s, report)
             })
         };
-        if threads == 1 && std::env::var_os("SLIVERMESH_PAR_FORCE").is_none() {
-            return serial(points);
+        if threads == 1 {
+            let cpu0 = tracing().then(on_cpu);
+            let r = serial(points);
+            if let Some(cpu0) = cpu0 {
+                eprintln!("serial kernel: {:.3} s on CPU", on_cpu() - cpu0);
+            }
+            return r;
         }
         let Ok(pool) = rayon::ThreadPoolBuilder::new().num_threads(threads).build() else {
             return serial(points);
@@ -616,22 +666,9 @@ impl Delaunay {
                 reason,
             });
         }
-        let trace = std::env::var_os("SLIVERMESH_PAR_TRACE").is_some();
-        let clock = std::time::Instant::now();
-        let lap = |what: &str| {
-            if trace {
-                let s = schedstat();
-                eprintln!(
-                    "{:8.3} s (run {:.3} wait {:.3}) {what}",
-                    clock.elapsed().as_secs_f64(),
-                    s.0 as f64 * 1e-9,
-                    s.1 as f64 * 1e-9
-                );
-            }
-        };
-        lap("checked");
+        let mut trace = Trace::new();
         let order = hilbert::brio_order_parallel(points, 0x5eed);
-        lap("brio");
+        trace.lap("brio order");
         let n = points.len();
         let mut dt = Delaunay {
             points: order.par_iter().map(|&i| points[i as usize]).collect(),
@@ -677,7 +714,6 @@ impl Delaunay {
                     break;
                 }
                 let before = pending.len();
-                lap("phase start");
                 pending = dt.phase(
                     &mut workers,
                     &pending,
@@ -685,22 +721,24 @@ impl Delaunay {
                     &mut part,
                     attempt,
                     &mut stats,
+                    &mut trace,
                 );
                 report.phases += 1;
                 report.parallel_points += before - pending.len();
-                lap(&format!(
-                    "phase {attempt} of {before}: {} left",
+                trace.lap(&format!(
+                    "phase {attempt}: {before} points, {} left",
                     pending.len()
                 ));
                 attempt += 1;
             }
             report.serial_points += pending.len();
             dt.insert_serially(&pending, &mut stats);
-            lap(&format!("round {round:?} serial {}", pending.len()));
+            trace.lap(&format!("round {round:?}: {} serially", pending.len()));
         }
         report.serial_points += 4;
         dt.renumber_parallel(&order, points);
-        lap("renumbered");
+        trace.lap("renumbered");
+        trace.summary();
         Ok((dt, stats, report))
     }
 
@@ -728,6 +766,7 @@ impl Delaunay {
 
     /// One parallel phase over `pending` (internal ids, BRIO order): returns the points the
     /// threads gave up, in BRIO order.
+    #[allow(clippy::too_many_arguments)] // the build's state, passed down once per phase
     fn phase(
         &mut self,
         workers: &mut [Worker],
@@ -736,10 +775,10 @@ impl Delaunay {
         part: &mut [u8],
         attempt: u32,
         stats: &mut InsertStats,
+        trace: &mut Trace,
     ) -> Vec<u32> {
         let threads = workers.len();
         self.partition(pending, keys, part, attempt, threads);
-        trace_lap("parts");
         for w in workers.iter_mut() {
             w.todo.clear();
         }
@@ -777,10 +816,8 @@ impl Delaunay {
         if self.tets.capacity() < self.tets.len() + fresh {
             self.tets.reserve_exact(fresh);
         }
-        trace_lap("start tets");
         self.tets.par_extend(rayon::iter::repeat_n(dead, fresh));
         self.mark.resize(self.tets.len(), 0);
-        trace_lap("slots");
         {
             let sh = Shared::new(
                 &mut self.tets,
@@ -791,13 +828,21 @@ impl Delaunay {
                 part,
             );
             let sh = &sh;
+            let on = trace.on;
+            let cpu0 = if on { on_cpu() } else { 0.0 };
             rayon::scope(|s| {
                 for w in workers.iter_mut() {
-                    s.spawn(move |_| w.run(sh));
+                    s.spawn(move |_| w.run(sh, on));
                 }
             });
+            if on {
+                // This thread ran some of the workers (or none); the phase's critical path is
+                // the busiest worker.
+                let mine = on_cpu() - cpu0;
+                let busiest = workers.iter().map(|w| w.cpu).fold(0.0, f64::max);
+                trace.excess += (busiest - mine).max(0.0);
+            }
         }
-        trace_lap("threads");
         // Merge: counts, slots, a hint, the deferred points.
         self.generation += 1;
         self.scratch.created.clear();
@@ -821,12 +866,11 @@ impl Delaunay {
             deferred.append(&mut w.deferred);
         }
         deferred.par_sort_unstable();
-        trace_lap("merged");
         deferred
     }
 
     /// Gives every vertex its part for phase `attempt` of `pending`. The first attempt cuts
-    /// the Hilbert curve into pieces of equal pending counts; later ones cut space into slabs
+    /// the Z-order curve into pieces of equal pending counts; later ones cut space into slabs
     /// of equal pending counts across the axis along which the pending points spread most
     /// (they lie near the earlier borders, which the new ones then cross).
     fn partition(
@@ -960,26 +1004,61 @@ fn slot_of(splits: &[u64], k: u64) -> u8 {
     splits.iter().filter(|&&b| b <= k).count() as u8
 }
 
-/// Prints the time since the last call, with what it was (`SLIVERMESH_PAR_TRACE` set).
-fn trace_lap(what: &str) {
-    use std::sync::Mutex;
-    static LAST: Mutex<Option<std::time::Instant>> = Mutex::new(None);
-    if std::env::var_os("SLIVERMESH_PAR_TRACE").is_none() {
-        return;
-    }
-    let now = std::time::Instant::now();
-    let mut last = LAST.lock().unwrap();
-    let dt = last.map_or(0.0, |l| (now - l).as_secs_f64());
-    *last = Some(now);
-    let s = schedstat();
-    eprintln!(
-        "   +{dt:.4} s {what} (thread run {:.3} wait {:.3})",
-        s.0 as f64 * 1e-9,
-        s.1 as f64 * 1e-9
-    );
+/// Whether `SLIVERMESH_PARALLEL_TRACE` asks for the diagnostics on stderr.
+fn tracing() -> bool {
+    std::env::var_os("SLIVERMESH_PARALLEL_TRACE").is_some()
 }
 
-/// Hilbert keys (63 bits) of `points` over their bounding box: the partition keys.
+/// Diagnostics of a parallel build on stderr (`SLIVERMESH_PARALLEL_TRACE` set): per step the
+/// wall clock and the building thread's on-CPU and run-queue seconds, and at the end the
+/// on-CPU time of the critical path (the building thread's, plus in each phase the busiest
+/// worker's excess over what this thread ran) — what the build would take on idle cores
+/// (Linux; elsewhere the CPU figures read 0).
+struct Trace {
+    on: bool,
+    clock: std::time::Instant,
+    excess: f64,
+    cpu0: f64,
+}
+
+impl Trace {
+    fn new() -> Self {
+        let on = tracing();
+        Trace {
+            on,
+            clock: std::time::Instant::now(),
+            excess: 0.0,
+            cpu0: if on { on_cpu() } else { 0.0 },
+        }
+    }
+
+    fn lap(&self, what: &str) {
+        if self.on {
+            let (run, wait) = schedstat();
+            eprintln!(
+                "{:8.3} s wall, this thread {:.3} s on CPU, {:.3} s waiting: {what}",
+                self.clock.elapsed().as_secs_f64(),
+                run as f64 * 1e-9,
+                wait as f64 * 1e-9
+            );
+        }
+    }
+
+    fn summary(&self) {
+        if self.on {
+            let mine = on_cpu() - self.cpu0;
+            eprintln!(
+                "critical path on CPU: {:.3} s (this thread {mine:.3} s, busiest workers' excess {:.3} s)",
+                mine + self.excess,
+                self.excess
+            );
+        }
+    }
+}
+
+/// Morton (Z-order) keys of `points` over their bounding box, 21 bits per axis: the partition
+/// keys. (Z-order rather than Hilbert: a tenth of the cost, and its first pieces are the same
+/// half and quarter boxes.)
 fn partition_keys(points: &[DVec3]) -> Vec<u64> {
     let (lo, hi) = points
         .par_iter()
@@ -997,14 +1076,15 @@ fn partition_keys(points: &[DVec3]) -> Vec<u64> {
         .par_iter()
         .map(|&p| {
             let c = (p - lo) * scale;
-            hilbert::hilbert_index([c.x as u32, c.y as u32, c.z as u32], KEY_BITS)
+            hilbert::morton_index([c.x as u32, c.y as u32, c.z as u32])
         })
         .collect()
 }
 
-#[cfg(test)]
-#[path = "parallel_tests.rs"]
-mod tests;
+/// On-CPU seconds of the calling thread.
+fn on_cpu() -> f64 {
+    schedstat().0 as f64 * 1e-9
+}
 
 /// (on-CPU ns, runqueue-wait ns) of the calling thread (tracing only).
 fn schedstat() -> (u64, u64) {
@@ -1014,3 +1094,7 @@ fn schedstat() -> (u64, u64) {
         .map(|x| x.parse::<u64>().unwrap_or(0));
     (it.next().unwrap_or(0), it.next().unwrap_or(0))
 }
+
+#[cfg(test)]
+#[path = "parallel_tests.rs"]
+mod tests;
