@@ -50,6 +50,9 @@ enum Command {
         /// Write the run's statistics as JSON to this file.
         #[arg(long, value_name = "FILE")]
         stats_json: Option<PathBuf>,
+        /// Threads for the triangulation (0: all cores). The tets are the same for any count.
+        #[arg(long, value_name = "N", default_value_t = 0)]
+        threads: usize,
     },
     /// Mesh a domain (.poly, .smesh, .off, .stl, .ply, .obj) with quality refinement, or remove the
     /// slivers of an existing mesh (.mesh). Output format by extension (.vtu, .mesh, .msh,
@@ -120,7 +123,8 @@ fn main() -> ExitCode {
             points,
             output,
             stats_json,
-        }) => run_delaunay(&points, output.as_deref(), stats_json.as_deref()),
+            threads,
+        }) => run_delaunay(&points, output.as_deref(), stats_json.as_deref(), threads),
         Some(Command::GenPoints {
             kind,
             n,
@@ -141,11 +145,12 @@ fn run_delaunay(
     points_path: &std::path::Path,
     output: Option<&std::path::Path>,
     stats_json: Option<&std::path::Path>,
+    threads: usize,
 ) -> Result<(), String> {
     let t0 = std::time::Instant::now();
     let points = slivermesh::io::points::read_points(points_path).map_err(|e| e.to_string())?;
     let read_seconds = t0.elapsed().as_secs_f64();
-    let (del, mut stats) = tri::triangulate(&points)
+    let (del, mut stats) = tri::triangulate(&points, threads)
         .map_err(|e| format!("{}: cannot triangulate: {e}", points_path.display()))?;
     stats.read_seconds = Some(read_seconds);
     print!("{}", tri::summary(&stats));

@@ -21,6 +21,8 @@ pub struct Stats {
     pub n_vertices: usize,
     pub n_duplicates: usize,
     pub n_tets: usize,
+    /// Threads the triangulation ran on (`--threads`, 0 resolved to the core count).
+    pub threads: usize,
     pub seconds: f64,
     pub points_per_second: f64,
     pub peak_rss_mb: Option<f64>,
@@ -35,13 +37,16 @@ pub struct Stats {
     pub read_seconds: Option<f64>,
 }
 
-/// Triangulates `points`, timing only `Delaunay::from_points`.
-pub fn triangulate(points: &[DVec3]) -> Result<(Delaunay, Stats), String> {
+/// Triangulates `points` on `threads` threads (0: all cores), timing only
+/// `Delaunay::from_points_threads`. The triangulation (and `tets_checksum`) is the same for any
+/// thread count.
+pub fn triangulate(points: &[DVec3], threads: usize) -> Result<(Delaunay, Stats), String> {
     if points.is_empty() {
         return Err("no points to triangulate".into());
     }
     let t0 = Instant::now();
-    let (del, ins) = Delaunay::from_points(points).map_err(|e| e.to_string())?;
+    let threads = slivermesh::delaunay::resolve_threads(threads);
+    let (del, ins) = Delaunay::from_points_threads(points, threads).map_err(|e| e.to_string())?;
     let seconds = t0.elapsed().as_secs_f64();
     let peak = rss::peak_rss_bytes();
     let n_tets = del.num_finite_tets();
@@ -58,6 +63,7 @@ pub fn triangulate(points: &[DVec3]) -> Result<(Delaunay, Stats), String> {
         n_vertices: del.num_vertices(),
         n_duplicates: ins.duplicates,
         n_tets,
+        threads,
         seconds,
         points_per_second: points.len() as f64 / seconds.max(1e-12),
         peak_rss_mb: peak.map(|b| b as f64 / 1e6),
@@ -84,7 +90,12 @@ pub fn summary(s: &Stats) -> String {
         out += "duplicates       0\n";
     }
     out += &format!("finite tets      {}\n", s.n_tets);
-    out += &format!("seconds          {:.3} (triangulation only)\n", s.seconds);
+    out += &format!(
+        "seconds          {:.3} (triangulation only, {} thread{})\n",
+        s.seconds,
+        s.threads,
+        if s.threads == 1 { "" } else { "s" }
+    );
     out += &format!("points/s         {:.0}\n", s.points_per_second);
     match (s.peak_rss_mb, s.bytes_per_tet) {
         (Some(mb), Some(bpt)) => {
@@ -182,6 +193,7 @@ mod tests {
             n_vertices: 9,
             n_duplicates: 1,
             n_tets: 20,
+            threads: 2,
             seconds: 0.5,
             points_per_second: 20.0,
             peak_rss_mb: Some(3.0),
@@ -198,6 +210,7 @@ mod tests {
             "1 (skipped)",
             "20",
             "0.500",
+            "2 threads",
             "3.0 MB",
             "150000.0",
             "100.0",

@@ -67,9 +67,9 @@ impl Scratch {
 /// reference to the outer neighbour's face, and the owner.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct BoundaryFace {
-    v: [u32; 3],
-    outer: u32,
-    owner: u32,
+    pub(super) v: [u32; 3],
+    pub(super) outer: u32,
+    pub(super) owner: u32,
 }
 
 impl BoundaryFace {
@@ -151,8 +151,8 @@ impl CavityWatch for NoWatch {
 }
 
 /// Cavity search marks (zero: not visited).
-const INSIDE: u8 = 1;
-const OUTSIDE: u8 = 2;
+pub(super) const INSIDE: u8 = 1;
+pub(super) const OUTSIDE: u8 = 2;
 const _: () = assert!(OUTSIDE - 1 == INSIDE);
 
 /// What inserting a point would do, computed without changing the triangulation.
@@ -689,7 +689,7 @@ struct EdgeSlot {
 impl EdgeTable {
     /// Starts a new cavity with `faces` boundary faces.
     #[inline]
-    fn begin(&mut self, faces: usize) {
+    pub(super) fn begin(&mut self, faces: usize) {
         // 3 directed edges per face: keep the load factor <= 3/16.
         let want = (faces * 16).next_power_of_two().max(512);
         if want > self.slots.len() {
@@ -706,7 +706,7 @@ impl EdgeTable {
 
     /// Registers directed edge `a -> b` owned by face reference `val`.
     #[inline]
-    fn insert(&mut self, a: u32, b: u32, val: u32) {
+    pub(super) fn insert(&mut self, a: u32, b: u32, val: u32) {
         let mask = self.slots.len() - 1;
         let mut slot = (edge_hash(a, b) >> self.shift) as usize;
         // SAFETY: slots are masked to the table length (a power of two).
@@ -725,7 +725,7 @@ impl EdgeTable {
     /// The owner of directed edge `a -> b`, which must have been registered (the cavity
     /// boundary is a closed surface: every edge appears once in each direction).
     #[inline]
-    fn get(&self, a: u32, b: u32) -> u32 {
+    pub(super) fn get(&self, a: u32, b: u32) -> u32 {
         let mask = self.slots.len() - 1;
         let want = edge_key(a, b);
         let mut slot = (edge_hash(a, b) >> self.shift) as usize;
@@ -745,7 +745,7 @@ impl EdgeTable {
         }
     }
 
-    fn memory_bytes(&self) -> usize {
+    pub(super) fn memory_bytes(&self) -> usize {
         self.slots.capacity() * std::mem::size_of::<EdgeSlot>()
     }
 }

@@ -6,6 +6,7 @@
 use glam::DVec3;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
+use rayon::prelude::*;
 
 /// Cell resolution per axis: 2^30 cells separate far more points than we ever sort.
 const BITS: u32 = 10;
@@ -53,6 +54,13 @@ pub fn hilbert_index(cell: [u32; 3], bits: u32) -> u64 {
     (spread3(x0) << 2) | (spread3(x1) << 1) | spread3(x2)
 }
 
+/// Morton (Z-order) index of a cell with 21-bit coordinates: bit b of x, y, z at bits 3b+2,
+/// 3b+1, 3b.
+#[inline]
+pub fn morton_index(cell: [u32; 3]) -> u64 {
+    (spread3(cell[0]) << 2) | (spread3(cell[1]) << 1) | spread3(cell[2])
+}
+
 /// Spreads the low 21 bits of `x` to every third bit.
 #[inline(always)]
 fn spread3(x: u32) -> u64 {
@@ -73,47 +81,102 @@ pub fn hilbert_sort(points: &[DVec3], ids: &mut [u32]) {
 
 /// [`hilbert_sort`] with a reusable buffer. Equal cells keep id order.
 fn hilbert_sort_with(points: &[DVec3], ids: &mut [u32], keyed: &mut Vec<u64>) {
+    hilbert_sort_impl(points, ids, keyed, false);
+}
+
+/// The sort of [`hilbert_sort_with`], its gather, keys and sort on the current rayon pool when
+/// `parallel`: the keys are distinct (the id is in their low half), so the order is the same.
+fn hilbert_sort_impl(points: &[DVec3], ids: &mut [u32], keyed: &mut Vec<u64>, parallel: bool) {
     if ids.len() < 2 {
         return;
     }
-    // One (random-access) gather; then bounding box and keys stream over the copy.
-    let local: Vec<DVec3> = ids.iter().map(|&i| points[i as usize]).collect();
-    let (mut lo, mut hi) = (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN));
-    for &p in &local {
-        lo = lo.min(p);
-        hi = hi.max(p);
-    }
+    let (lo, hi) = if parallel {
+        let (lo, hi) = ids
+            .par_iter()
+            .fold(
+                || (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)),
+                |(lo, hi), &i| (lo.min(points[i as usize]), hi.max(points[i as usize])),
+            )
+            .reduce(
+                || (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)),
+                |a, b| (a.0.min(b.0), a.1.max(b.1)),
+            );
+        (lo, hi)
+    } else {
+        // One (random-access) gather; then bounding box and keys stream over the copy.
+        let local: Vec<DVec3> = ids.iter().map(|&i| points[i as usize]).collect();
+        let (mut lo, mut hi) = (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN));
+        for &p in &local {
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+        let extent = (hi - lo).max_element().max(f64::MIN_POSITIVE);
+        let scale = ((1u32 << BITS) - 1) as f64 / extent;
+        keyed.clear();
+        keyed.extend(local.iter().zip(ids.iter()).map(|(&p, &i)| {
+            let c = (p - lo) * scale;
+            (hilbert_index([c.x as u32, c.y as u32, c.z as u32], BITS) << 32) | i as u64
+        }));
+        keyed.sort_unstable();
+        for (slot, &k) in ids.iter_mut().zip(keyed.iter()) {
+            *slot = k as u32;
+        }
+        return;
+    };
     let extent = (hi - lo).max_element().max(f64::MIN_POSITIVE);
     let scale = ((1u32 << BITS) - 1) as f64 / extent;
     keyed.clear();
-    keyed.extend(local.iter().zip(ids.iter()).map(|(&p, &i)| {
-        let c = (p - lo) * scale;
-        (hilbert_index([c.x as u32, c.y as u32, c.z as u32], BITS) << 32) | i as u64
-    }));
-    keyed.sort_unstable();
-    for (slot, &k) in ids.iter_mut().zip(keyed.iter()) {
-        *slot = k as u32;
-    }
+    ids.par_iter()
+        .map(|&i| {
+            let c = (points[i as usize] - lo) * scale;
+            (hilbert_index([c.x as u32, c.y as u32, c.z as u32], BITS) << 32) | i as u64
+        })
+        .collect_into_vec(keyed);
+    keyed.par_sort_unstable();
+    ids.par_iter_mut()
+        .zip(keyed.par_iter())
+        .for_each(|(slot, &k)| *slot = k as u32);
 }
 
 /// BRIO order of all point ids: a seeded shuffle, then rounds of geometrically growing size,
 /// each Hilbert-sorted.
 pub fn brio_order(points: &[DVec3], seed: u64) -> Vec<u32> {
+    brio_order_impl(points, seed, false)
+}
+
+/// [`brio_order`] with its sorts on the current rayon pool: the same order.
+pub fn brio_order_parallel(points: &[DVec3], seed: u64) -> Vec<u32> {
+    brio_order_impl(points, seed, true)
+}
+
+fn brio_order_impl(points: &[DVec3], seed: u64, parallel: bool) -> Vec<u32> {
     let mut ids: Vec<u32> = (0..points.len() as u32).collect();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
     ids.shuffle(&mut rng);
     let mut keyed = Vec::with_capacity(points.len());
-    let mut end = ids.len();
+    for round in brio_rounds(points.len()).into_iter().rev() {
+        hilbert_sort_impl(points, &mut ids[round], &mut keyed, parallel);
+    }
+    ids
+}
+
+/// The rounds of [`brio_order`] for `n` points, as ranges of positions in the order, first
+/// round first: each round is `ROUND_RATIO` times the points before it, the first at most
+/// `MIN_ROUND`.
+pub fn brio_rounds(n: usize) -> Vec<std::ops::Range<usize>> {
+    let mut rounds = vec![];
+    let mut end = n;
     while end > 0 {
         let start = if end > MIN_ROUND {
             end / ROUND_RATIO
         } else {
             0
         };
-        hilbert_sort_with(points, &mut ids[start..end], &mut keyed);
+        rounds.push(start..end);
         end = start;
     }
-    ids
+    rounds.reverse();
+    rounds
 }
 
 #[cfg(test)]
@@ -220,6 +283,28 @@ mod tests {
             let d: u32 = (0..3).map(|i| w[0].1[i].abs_diff(w[1].1[i])).sum();
             assert_eq!(d, 1, "step {k}: {:?} -> {:?}", w[0].1, w[1].1);
         }
+    }
+
+    #[test]
+    fn parallel_brio_is_the_same_order() {
+        let mut pts: Vec<DVec3> = (0..30_000)
+            .map(|i| {
+                let f = |k: u64| ((i as u64 * k) % 1009) as f64 / 1009.0;
+                DVec3::new(f(7919), f(104_729), f(1_299_709))
+            })
+            .collect();
+        // Equal cells and equal points too.
+        pts.extend_from_within(..3000);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(3)
+            .build()
+            .unwrap();
+        let parallel = pool.install(|| brio_order_parallel(&pts, 9));
+        assert_eq!(parallel, brio_order(&pts, 9));
+        let rounds = brio_rounds(pts.len());
+        assert_eq!(rounds.first().unwrap().start, 0);
+        assert_eq!(rounds.last().unwrap().end, pts.len());
+        assert!(rounds.windows(2).all(|w| w[0].end == w[1].start));
     }
 
     #[test]

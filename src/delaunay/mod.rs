@@ -15,12 +15,14 @@
 mod cavity;
 pub mod hilbert;
 mod locate;
+mod parallel;
 pub mod tables;
 mod validate;
 
 use crate::geom::{self, orient3d};
 pub use cavity::{BoundaryFace, Cavity, CavityWatch, DryRun, Probe};
 use glam::DVec3;
+pub use parallel::{resolve_threads, ParallelReport, MAX_THREADS};
 use tables::FACE;
 
 /// Id of the vertex at infinity (hull tets carry it).
