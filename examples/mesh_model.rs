@@ -1,6 +1,8 @@
 //! Meshes one model file and prints the report: `cargo run --release --example mesh_model -- FILE [--no-refine] [--size H]`
 use slivermesh::io::{read_plc, ReadOptions};
-use slivermesh::refine::{mesh, ConstantSpacing, Params, Spacing};
+use slivermesh::refine::mesh;
+use slivermesh::run::params::Params;
+use slivermesh::run::spacing::{ConstantSpacing, Spacing};
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let path = std::path::Path::new(&args[1]);

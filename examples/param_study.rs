@@ -4,7 +4,9 @@
 //!     cargo run --release --example param_study [size]
 
 use slivermesh::io::{read_plc, ReadOptions};
-use slivermesh::refine::{mesh, ConstantSpacing, Params};
+use slivermesh::refine::mesh;
+use slivermesh::run::params::Params;
+use slivermesh::run::spacing::ConstantSpacing;
 use std::path::PathBuf;
 
 fn main() {

@@ -1,10 +1,14 @@
 //! slivermesh: quality, sliver-free Delaunay tetrahedral meshing.
 //!
 //! Layers, top to bottom (each knows only the ones below it):
-//! `ffi` (C ABI) → `api` (safe Rust API) → `io` (file formats) → `plc` (input validation)
-//! → `refine` (Li's REMOVE-SLIVER) → `delaunay` (3D kernel) → `geom` (exact predicates, measures).
-//! `improve` (flips, smoothing) works on refine's output mesh.
-//! `mesh` holds the output model shared by writers and meshers. See ARCHITECTURE.md.
+//! `ffi` (C ABI) → `api` (safe Rust API) → `pipeline` (the whole run: stages composed, their
+//! reports put together) → `approx` (approximate surface mode) → `refine` (Li's REMOVE-SLIVER)
+//! and `improve` (flips, smoothing; neither names the other) → `run` (the run's vocabulary:
+//! parameters, error, spacing, progress, report) → `plc` (input validation), `surface`, `cdt`
+//! → `delaunay` (3D kernel) → `geom` (exact predicates, measures).
+//! `io` (file formats) reads and writes for `api`; `mesh` holds the output model shared by
+//! writers and meshers. `tests/layering.rs` checks the imports of `run`, `refine` and
+//! `improve`. See ARCHITECTURE.md.
 
 #![deny(clippy::undocumented_unsafe_blocks)]
 
@@ -22,6 +26,7 @@ pub mod plc;
 pub mod quadratic;
 pub mod quality;
 pub mod refine;
+pub mod run;
 pub mod surface;
 mod union_find;
 

@@ -1,10 +1,16 @@
-//! The whole meshing run as the API, the CLI and the C ABI call it: the surface mode's boundary
-//! (kept as given, or approximated by `crate::approx`), refinement, then the improvement pass
-//! and the check that no tet is degenerate.
+//! The whole meshing run as the API calls it: the surface mode's boundary (kept as given, or
+//! approximated by `crate::approx`), refinement, then the improvement pass and the check that
+//! no tet is degenerate. Each stage reports its own part (refinement the `Report` of the refined
+//! mesh, the improvement its `ImproveStats`); the whole run's report is put together here.
 
 use crate::mesh::{QuadraticNodes, TetMesh};
 use crate::plc::PlcInput;
-use crate::refine::{self, MeshError, Params, Progress, Report, Spacing, SurfaceMode};
+use crate::refine;
+use crate::run::error::MeshError;
+use crate::run::params::{Params, SurfaceMode};
+use crate::run::progress::Progress;
+use crate::run::report::Report;
+use crate::run::spacing::Spacing;
 
 /// Meshes `input` in `params.surface_mode`, improves the result (`params.improve`) and checks
 /// that no tet is flat or inverted; the report gets each region's figures. `spacing` None =
@@ -27,7 +33,7 @@ pub fn mesh(
         }
         SurfaceMode::Keep => {
             let (mesh, mut report) = refine::mesh(input, params, spacing, progress)?;
-            let mesh = crate::improve::finish(mesh, &mut report, Some(input), params, None)?;
+            let mesh = improve(mesh, &mut report, Some(input), params)?;
             let quadratic = (params.order == 2).then(|| {
                 let (nodes, quadratic_report) = crate::quadratic::elevate(&mesh, None);
                 report.quadratic = Some(quadratic_report);
@@ -57,11 +63,29 @@ pub fn remove_slivers(
         ));
     }
     let (mesh, mut report) = refine::existing::remove_slivers(existing, params)?;
-    let mesh = crate::improve::finish(mesh, &mut report, None, params, None)?;
+    let mesh = improve(mesh, &mut report, None, params)?;
     let quadratic = (params.order == 2).then(|| {
         let (nodes, quadratic_report) = crate::quadratic::elevate(&mesh, None);
         report.quadratic = Some(quadratic_report);
         nodes
     });
     Ok((mesh, quadratic, report))
+}
+
+/// The improvement pass (`improve::finish`) on a refined mesh, recorded in its `report`: the
+/// shape figures re-measured when the mesh changed (the size figures stay the refinement's),
+/// the dihedral range before, the stats and the time.
+fn improve(
+    mesh: TetMesh,
+    report: &mut Report,
+    input: Option<&PlcInput>,
+    params: &Params,
+) -> Result<TetMesh, MeshError> {
+    let before = report.dihedral_range();
+    let (mesh, stats) = crate::improve::finish(mesh, input, params, None)?;
+    if stats.changed() {
+        report.measure_shapes(&mesh);
+    }
+    report.record_improvement(stats, before);
+    Ok(mesh)
 }

@@ -10,7 +10,10 @@ use slivermesh::geom::TetQuality;
 use slivermesh::io::medit::{format_medit, parse_medit};
 use slivermesh::plc::{Facet, PlcInput, Region};
 use slivermesh::refine::existing::remove_slivers;
-use slivermesh::refine::{mesh, ConstantSpacing, Params, Report};
+use slivermesh::refine::mesh;
+use slivermesh::run::params::Params;
+use slivermesh::run::report::Report;
+use slivermesh::run::spacing::ConstantSpacing;
 use slivermesh::{DVec3, TetMesh};
 use std::collections::HashMap;
 

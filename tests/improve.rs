@@ -10,7 +10,7 @@ use slivermesh::geom::TetQuality;
 use slivermesh::improve;
 use slivermesh::TetMesh;
 
-fn mesh(rel: &str, improve_on: bool) -> (TetMesh, slivermesh::refine::Report) {
+fn mesh(rel: &str, improve_on: bool) -> (TetMesh, slivermesh::run::report::Report) {
     let mut m = Mesher::from_plc(read_model(rel)).unwrap();
     m.set_param("improve", if improve_on { 1.0 } else { 0.0 })
         .unwrap();

@@ -3,7 +3,8 @@
 
 mod common;
 use common::*;
-use slivermesh::refine::{mesh, Params};
+use slivermesh::refine::mesh;
+use slivermesh::run::params::Params;
 
 /// Expected volumes (models/README.md).
 const POLY: &[(&str, f64)] = &[

@@ -10,7 +10,8 @@ use common::corpus;
 use common::ScratchDir;
 use slivermesh::mesh::{QuadraticNodes, TET_EDGES, TRIANGLE_EDGES};
 use slivermesh::pipeline;
-use slivermesh::refine::{ConstantSpacing, Params, SurfaceMode};
+use slivermesh::run::params::{Params, SurfaceMode};
+use slivermesh::run::spacing::ConstantSpacing;
 use slivermesh::{DVec3, TetMesh};
 
 /// The icosphere's level: 20 * 4^6 = 81,920 triangles.

@@ -5,7 +5,9 @@
 mod common;
 use common::*;
 use slivermesh::geom::TetQuality;
-use slivermesh::refine::{mesh, ConstantSpacing, FnSpacing, Params, Spacing};
+use slivermesh::refine::mesh;
+use slivermesh::run::params::Params;
+use slivermesh::run::spacing::{ConstantSpacing, FnSpacing, Spacing};
 use slivermesh::{DVec3, TetMesh};
 
 const ACUTE_FREE: &[(&str, Option<f64>)] = &[
@@ -181,7 +183,7 @@ fn vertex_budget_too_small_for_boundary_recovery_is_invalid_input() {
         ..Params::default()
     };
     match mesh(&input, &params, None, None) {
-        Err(slivermesh::refine::MeshError::InvalidInput(m)) => {
+        Err(slivermesh::run::error::MeshError::InvalidInput(m)) => {
             assert!(m.contains("max_vertices"), "{m}")
         }
         r => panic!("expected InvalidInput, got {:?}", r.map(|(_, r)| r)),
@@ -202,7 +204,10 @@ fn progress_callback_can_cancel() {
         Some(&ConstantSpacing(0.03)),
         Some(&mut cb),
     );
-    assert!(matches!(r, Err(slivermesh::refine::MeshError::Cancelled)));
+    assert!(matches!(
+        r,
+        Err(slivermesh::run::error::MeshError::Cancelled)
+    ));
     assert!(calls >= 1);
 }
 
@@ -215,7 +220,7 @@ fn progress_callback_can_cancel() {
 #[test]
 fn acute_models_terminate_and_meet_bounds_away_from_small_angles() {
     let params = Params::default();
-    let mut seen = slivermesh::refine::Refusals::default();
+    let mut seen = slivermesh::run::report::Refusals::default();
     for rel in [
         "off/star.off",
         "off/oblong.off",
@@ -341,7 +346,8 @@ fn slivers_of_an_existing_mesh_are_removed() {
 /// of any of them fails the run (the minimum does not hide a NaN).
 #[test]
 fn minimum_of_spacings_is_respected_and_keeps_bad_values() {
-    use slivermesh::refine::{MeshError, MinSpacing};
+    use slivermesh::run::error::MeshError;
+    use slivermesh::run::spacing::MinSpacing;
     let fine_zone = |p: DVec3| if p.x < 0.3 { 0.06 } else { 10.0 };
     let f = MinSpacing(vec![
         Box::new(ConstantSpacing(0.2)),

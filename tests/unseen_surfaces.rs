@@ -425,8 +425,8 @@ fn several_regions_in_keep_mode() {
         let path = dir.0.join(shape.file_name());
         std::fs::write(&path, shape.file_text()).unwrap();
         let input = slivermesh::io::read_plc(&path, &Default::default()).unwrap();
-        let params = slivermesh::refine::Params {
-            surface_mode: slivermesh::refine::SurfaceMode::Keep,
+        let params = slivermesh::run::params::Params {
+            surface_mode: slivermesh::run::params::SurfaceMode::Keep,
             ..Default::default()
         };
         let (mesh, _, report) = slivermesh::pipeline::mesh(&input, &params, None, None)
@@ -467,10 +467,10 @@ fn several_regions_are_deterministic() {
     std::fs::write(&path, shape.file_text()).unwrap();
     let input = slivermesh::io::read_plc(&path, &Default::default()).unwrap();
     for mode in [
-        slivermesh::refine::SurfaceMode::Keep,
-        slivermesh::refine::SurfaceMode::Approximate,
+        slivermesh::run::params::SurfaceMode::Keep,
+        slivermesh::run::params::SurfaceMode::Approximate,
     ] {
-        let params = slivermesh::refine::Params {
+        let params = slivermesh::run::params::Params {
             surface_mode: mode,
             ..Default::default()
         };

@@ -1,7 +1,7 @@
 //! The one error type of the safe API.
 
 use crate::io::IoError;
-use crate::refine::MeshError;
+use crate::run::error::MeshError;
 
 /// Why an [`super::Mesher`] call failed. Every message names the offending item (vertex index,
 /// facet index, parameter name, point).

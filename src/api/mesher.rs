@@ -8,7 +8,10 @@ use super::spacing::{valid_value, Checked, SpacingChoice};
 use crate::geom::MAX_COORD;
 use crate::mesh::TetMesh;
 use crate::plc::{Facet, PlcInput, Region};
-use crate::refine::{ConstantSpacing, FnSpacing, MeshError, Progress, Report, Spacing};
+use crate::run::error::MeshError;
+use crate::run::progress::Progress;
+use crate::run::report::Report;
+use crate::run::spacing::{ConstantSpacing, FnSpacing, Spacing};
 use glam::DVec3;
 use std::path::Path;
 

@@ -28,7 +28,9 @@ pub use spacing::SpacingChoice;
 
 pub use crate::mesh::TetMesh;
 pub use crate::plc::PlcInput;
-pub use crate::refine::{ConstantSpacing, FnSpacing, MeshError, MinSpacing, Report, Spacing};
+pub use crate::run::error::MeshError;
+pub use crate::run::report::Report;
+pub use crate::run::spacing::{ConstantSpacing, FnSpacing, MinSpacing, Spacing};
 
 #[cfg(test)]
 mod tests;

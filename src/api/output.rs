@@ -4,7 +4,7 @@ use super::error::Error;
 use crate::geom::TetQuality;
 use crate::io::CellField;
 use crate::mesh::{QuadraticNodes, TetMesh};
-use crate::refine::Report;
+use crate::run::report::Report;
 use std::path::Path;
 
 /// The mesh and the report of one successful [`super::Mesher::refine`].

@@ -270,7 +270,7 @@ pub fn markdown_table() -> String {
 mod tests {
     use super::super::params::{get_param, set_param, PARAM_NAMES};
     use super::*;
-    use crate::refine::Params;
+    use crate::run::params::Params;
 
     #[test]
     fn names_are_the_apis() {

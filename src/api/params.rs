@@ -3,7 +3,7 @@
 
 use super::error::{invalid, Error};
 use crate::geom::{REGULAR_DIHEDRAL, REGULAR_RHO, REGULAR_SIGMA};
-pub use crate::refine::{Params, SurfaceMode};
+pub use crate::run::params::{Params, SurfaceMode};
 
 /// Every name [`set_param`] accepts, in documentation order (`"B"` is an alias of
 /// `"size_factor"`).
@@ -175,7 +175,9 @@ fn set_unchecked(params: &mut Params, name: &str, value: f64) -> Result<(), Erro
             params.surface_distance = value;
         }
         "improve_target" => {
-            if !(value.is_finite() && (0.0..=crate::refine::MAX_IMPROVE_TARGET).contains(&value)) {
+            if !(value.is_finite()
+                && (0.0..=crate::run::params::MAX_IMPROVE_TARGET).contains(&value))
+            {
                 return invalid(format!(
                     "improve_target = {value} is out of range [0, 40] degrees: improvement works \
                      on tets with a smaller dihedral angle (0 = the mode's default, 26 keep / \

@@ -1,7 +1,8 @@
 //! The spacing a [`super::Mesher`] uses, and the guard that makes any spacing value that is not
 //! finite and positive fail the run with the point that produced it.
 
-use crate::refine::{MeshError, Spacing};
+use crate::run::error::MeshError;
+use crate::run::spacing::Spacing;
 use glam::DVec3;
 use std::cell::Cell;
 
@@ -98,7 +99,7 @@ impl Spacing for Checked<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::refine::FnSpacing;
+    use crate::run::spacing::FnSpacing;
 
     #[test]
     fn checked_passes_values_through_and_keeps_the_first_bad_one() {

@@ -347,7 +347,7 @@ fn refine_dispatches_on_the_surface_mode() {
 
 #[test]
 fn improve_target_defaults_by_surface_mode() {
-    use crate::refine::{APPROXIMATE_IMPROVE_TARGET, KEEP_IMPROVE_TARGET};
+    use crate::run::params::{APPROXIMATE_IMPROVE_TARGET, KEEP_IMPROVE_TARGET};
     let mut p = Params::default();
     assert_eq!(p.effective_improve_target(), KEEP_IMPROVE_TARGET);
     p.surface_mode = SurfaceMode::Approximate;

@@ -24,10 +24,12 @@ pub use curves::SMALL_CORNER_DEG;
 
 use crate::mesh::{QuadraticNodes, TetMesh};
 use crate::plc::{Facet, PlcInput};
-use crate::refine::{
-    AutoSpacing, ConstantSpacing, MarkerCapped, MarkerCaps, MeshError, Params, Progress, Report,
-    Spacing, DEFAULT_SURFACE_DISTANCE_FRACTION,
-};
+use crate::refine::{AutoSpacing, MarkerCapped, MarkerCaps};
+use crate::run::error::MeshError;
+use crate::run::params::{Params, DEFAULT_SURFACE_DISTANCE_FRACTION};
+use crate::run::progress::Progress;
+use crate::run::report::Report;
+use crate::run::spacing::{ConstantSpacing, Spacing};
 use crate::surface::features::{FeatureParams, Features};
 use crate::surface::oracle::SurfaceOracle;
 use crate::surface::repair::{Defects, Repaired};
@@ -143,17 +145,10 @@ pub fn mesh(
         Some(_) => &capped,
         None => f,
     };
-    let measure_final = |mesh: &TetMesh, report: &mut Report| {
-        measure_volume(mesh, f, params, &remeshed.small_corners, report)
-    };
-    let mesh = crate::improve::finish_with(
-        mesh,
-        &mut report,
-        None,
-        params,
-        Some(&slide),
-        Some(&measure_final),
-    )?;
+    let before = report.dihedral_range();
+    let (mesh, stats) = crate::improve::finish(mesh, None, params, Some(&slide))?;
+    measure_volume(&mesh, f, params, &remeshed.small_corners, &mut report)?;
+    report.record_improvement(stats, before);
     let mut surface_report = measure::surface_report(&remeshed, &mesh);
     (
         surface_report.n_bad_near_small_corners,

@@ -33,7 +33,9 @@ use crate::delaunay::tables::FACE;
 use crate::delaunay::{Cavity, Delaunay, Inserted, Probe, INFINITE};
 use crate::geom::tri_circumcenter;
 use crate::refine::outcome::{BoundaryKind, Outcome, Refusal};
-use crate::refine::{MarkerCaps, MeshError, Spacing, SPACING_BATCH};
+use crate::refine::{MarkerCaps, SPACING_BATCH};
+use crate::run::error::MeshError;
+use crate::run::spacing::Spacing;
 use crate::surface::oracle::{Crossing, SurfaceOracle};
 use crate::surface::repair::{Repaired, HIDDEN};
 use crate::surface::thickness::Thickness;
@@ -569,7 +571,7 @@ impl<'a> SurfaceMesher<'a> {
     pub fn run_with_volume(
         mut self,
         crit: VolumeCriteria,
-        mut progress: Option<crate::refine::Progress>,
+        mut progress: Option<crate::run::progress::Progress>,
     ) -> Result<(Boundary, VolumeMesh), MeshError> {
         let start = std::time::Instant::now();
         let (faces, stop_reason) = self.rounds(&mut Self::refine)?;

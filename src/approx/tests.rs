@@ -1,6 +1,7 @@
 use super::*;
 use crate::io::{read_plc, ReadOptions};
-use crate::refine::{ConstantSpacing, SurfaceMode};
+use crate::run::params::SurfaceMode;
+use crate::run::spacing::ConstantSpacing;
 use std::path::Path;
 
 fn model(name: &str) -> PlcInput {

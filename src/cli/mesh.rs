@@ -6,9 +6,9 @@ use slivermesh::io::{self, ReadOptions};
 use slivermesh::mesh::{QuadraticNodes, TetMesh};
 use slivermesh::pipeline;
 use slivermesh::plc::{Facet, PlcInput, Region};
-use slivermesh::refine::{
-    ConstantSpacing, FnSpacing, Params, Report, Spacing, SurfaceMode, SurfaceReport,
-};
+use slivermesh::run::params::{Params, SurfaceMode};
+use slivermesh::run::report::{Report, SurfaceReport};
+use slivermesh::run::spacing::{ConstantSpacing, FnSpacing, Spacing};
 use slivermesh::DVec3;
 use std::io::IsTerminal;
 use std::path::Path;
@@ -101,7 +101,7 @@ pub struct MeshOptions {
     pub order: u8,
 }
 
-/// `--surface`: how the input facets bound the domain (`refine::SurfaceMode`).
+/// `--surface`: how the input facets bound the domain (`run::params::SurfaceMode`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum SurfaceArg {
     /// Every input facet is preserved exactly.

@@ -4,7 +4,7 @@
 //! they live in the handle and are lent to `Mesher::refine_with` for one run on the calling
 //! thread, never stored in the (`Send`) `Mesher` itself.
 
-use crate::refine::Spacing;
+use crate::run::spacing::Spacing;
 use glam::DVec3;
 use std::ffi::c_void;
 

@@ -4,7 +4,7 @@ use super::guard::{handle_call, handle_query};
 use super::mesher::sm_mesher;
 use super::slices::output;
 use super::status::*;
-use crate::refine::Report;
+use crate::run::report::Report;
 
 /// What the last `sm_refine` achieved (the report's figures). Measures: rho = R/L (circumradius
 /// over shortest edge; regular tet 0.612), sigma = V/L^3 (regular 0.1179), dihedral angles in

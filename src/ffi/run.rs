@@ -3,7 +3,7 @@
 use super::guard::handle_call;
 use super::mesher::sm_mesher;
 use super::status::*;
-use crate::refine::Spacing;
+use crate::run::spacing::Spacing;
 use std::ffi::CString;
 
 /// Meshes the domain: validation, boundary recovery (the input facets as given when

@@ -3,7 +3,7 @@
 
 use super::*;
 use crate::mesh::TetMesh;
-use crate::refine::Report;
+use crate::run::report::Report;
 use glam::DVec3;
 use std::ffi::{c_char, c_void, CStr};
 use std::ptr::{null, null_mut};

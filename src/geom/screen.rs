@@ -237,7 +237,7 @@ mod tests {
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
-    /// The bounds refinement screens against by default (`refine::Params`).
+    /// The bounds refinement screens against by default (`run::params::Params`).
     struct Bounds {
         sigma0: f64,
         min_dihedral: f64,

@@ -29,11 +29,12 @@ pub mod quality;
 mod smooth;
 mod topo;
 
-use crate::geom::{orient3d, TetQuality};
+use crate::geom::orient3d;
 use crate::mesh::TetMesh;
 use crate::plc::PlcInput;
-use crate::refine::report::Shapes;
-use crate::refine::{MeshError, Report};
+use crate::run::error::MeshError;
+use crate::run::params::{Params, SurfaceMode};
+use crate::run::report::ImproveStats;
 use constraints::Constraint;
 use glam::DVec3;
 use std::cmp::Reverse;
@@ -55,7 +56,7 @@ pub struct Options {
     pub max_rho: f64,
     /// Radius-edge bound no change may break: a change that would make a tet exceed it is
     /// refused unless a tet it replaces exceeded it already, and then the new ones may not
-    /// exceed the worst of those (`Stats::rho_vetoes` counts the refusals); infinite: none.
+    /// exceed the worst of those (`ImproveStats::rho_vetoes` counts the refusals); infinite: none.
     pub keep_rho: f64,
 }
 
@@ -71,60 +72,14 @@ impl Default for Options {
     }
 }
 
-/// What the improver did.
-#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
-pub struct Stats {
-    pub edge_removals: usize,
-    pub face_removals: usize,
-    /// Face removals that took out more than one face.
-    pub multi_face_removals: usize,
-    pub boundary_flips: usize,
-    pub smoothed: usize,
-    /// Vertices inserted where flips and smoothing left a tet bad.
-    pub insertions: usize,
-    /// Free interior vertices removed: contracted onto a neighbour where that did better than
-    /// an insertion, or swallowed by an insertion's cavity.
-    pub deletions: usize,
-    /// Vertices smoothing was tried on (`smoothed` of them moved).
-    pub smooth_attempts: usize,
-    pub passes: usize,
-    /// Tets flat or inverted (exact orient3d <= 0) before the pass.
-    pub degenerate_before: usize,
-    /// Changes that would have raised the worst angle objective but were refused because a
-    /// tet would have exceeded the radius-edge bound (`Options::keep_rho`): where the dihedral
-    /// target gave way to rho0.
-    pub rho_vetoes: usize,
-    /// Changes made although a new tet exceeds the bound, next to where refinement left it
-    /// unmet (small input angles): where rho0 gave way to the dihedral target.
-    pub rho_yields: usize,
-    pub seconds: f64,
-    /// Of which planning topological changes, and smoothing.
-    pub seconds_plans: f64,
-    pub seconds_smooth: f64,
-}
-
-impl Stats {
-    /// Whether the mesh was changed at all.
-    pub fn changed(&self) -> bool {
-        self.edge_removals
-            + self.face_removals
-            + self.multi_face_removals
-            + self.boundary_flips
-            + self.smoothed
-            + self.insertions
-            + self.deletions
-            > 0
-    }
-}
-
 pub(crate) struct Improver<'s> {
     w: Work,
     cons: Vec<Constraint>,
     normals: Vec<DVec3>,
     /// Approximate mode: the boundary vertices that slide on the input surface, and how.
     slide: Option<&'s dyn SurfaceSlide>,
-    stats: Stats,
-    /// Changes refused for the radius-edge bound (`Stats::rho_vetoes`; counted by planners
+    stats: ImproveStats,
+    /// Changes refused for the radius-edge bound (`ImproveStats::rho_vetoes`; counted by planners
     /// that only read the mesh).
     rho_vetoes: std::cell::Cell<usize>,
     rho_yields: std::cell::Cell<usize>,
@@ -172,7 +127,11 @@ fn key(q: f64) -> u64 {
 /// Improves `mesh`. `input` is the domain it was made from (keep mode): with it, boundary
 /// vertices move within their facet or segment and boundary triangles of one facet may flip;
 /// without it (an existing mesh) the boundary stays as it is.
-pub fn improve(mesh: &TetMesh, input: Option<&PlcInput>, opts: &Options) -> (TetMesh, Stats) {
+pub fn improve(
+    mesh: &TetMesh,
+    input: Option<&PlcInput>,
+    opts: &Options,
+) -> (TetMesh, ImproveStats) {
     improve_with(mesh, input, opts, None)
 }
 
@@ -183,7 +142,7 @@ pub fn improve_with(
     input: Option<&PlcInput>,
     opts: &Options,
     slide: Option<&dyn SurfaceSlide>,
-) -> (TetMesh, Stats) {
+) -> (TetMesh, ImproveStats) {
     let start = std::time::Instant::now();
     let objective = quality::Objective::new(opts.target_deg, opts.max_rho);
     let mut w = Work::new(mesh, objective);
@@ -197,7 +156,7 @@ pub fn improve_with(
         cons,
         normals,
         slide,
-        stats: Stats::default(),
+        stats: ImproveStats::default(),
         rho_vetoes: Default::default(),
         rho_yields: Default::default(),
     };
@@ -450,54 +409,24 @@ pub fn check_no_degenerate(mesh: &TetMesh) -> Result<(), MeshError> {
     Ok(())
 }
 
-/// Re-measures the shape figures of `report` (counts, rho, sigma, dihedral angles, tets below
-/// 5/10/15/20 degrees) on `mesh`; size figures stay those of the refinement.
-pub fn update_report(report: &mut Report, mesh: &TetMesh) {
-    let mut shapes = Shapes::new();
-    for t in &mesh.tets {
-        let p = t.map(|v| mesh.vertices[v as usize]);
-        shapes.add(&TetQuality::of(p[0], p[1], p[2], p[3]));
-    }
-    shapes.write(mesh, report);
-}
-
-/// Measures an improved mesh into the report (all of its figures, not only the shapes that
-/// [`update_report`] re-measures): the approximate mode's closure, which knows the spacing and
-/// where quality is not enforced.
-pub type Remeasure<'a> = &'a dyn Fn(&TetMesh, &mut Report) -> Result<(), MeshError>;
-
 /// The step every mesher output goes through: improvement (or, with `params.improve` false,
 /// only the removal of flat and inverted tets; in approximate mode tets over `params.rho0`
-/// count as bad), the check that no tet is degenerate, and the
-/// report's shape figures re-measured when the mesh changed.
+/// count as bad) and the check that no tet is degenerate. Returns the mesh and what the pass
+/// did; the caller re-measures what it reports (`Report::measure_shapes` when
+/// [`ImproveStats::changed`]) and records the stats (`Report::record_improvement`).
 pub fn finish(
     mesh: TetMesh,
-    report: &mut Report,
     input: Option<&PlcInput>,
-    params: &crate::refine::Params,
+    params: &Params,
     slide: Option<&dyn SurfaceSlide>,
-) -> Result<TetMesh, MeshError> {
-    finish_with(mesh, report, input, params, slide, None)
-}
-
-/// [`finish`], with the report measured on the result by `remeasure` (always, changed or not)
-/// instead of [`update_report`]. `report`'s dihedral range on entry is the mesh's before
-/// improvement.
-pub fn finish_with(
-    mesh: TetMesh,
-    report: &mut Report,
-    input: Option<&PlcInput>,
-    params: &crate::refine::Params,
-    slide: Option<&dyn SurfaceSlide>,
-    remeasure: Option<Remeasure>,
-) -> Result<TetMesh, MeshError> {
+) -> Result<(TetMesh, ImproveStats), MeshError> {
     let opts = Options {
         improve: params.improve,
         // Keep mode leaves tets over rho0 next to small input angles, where the cap made the
         // improver trade angles for them (spool: 4 -> 61 tets below 5 degrees): angles only.
         max_rho: match params.surface_mode {
-            crate::refine::SurfaceMode::Approximate => params.rho0,
-            crate::refine::SurfaceMode::Keep => f64::INFINITY,
+            SurfaceMode::Approximate => params.rho0,
+            SurfaceMode::Keep => f64::INFINITY,
         },
         target_deg: params.effective_improve_target(),
         // Keep mode: rho0 holds wherever refinement met it. Approximate mode: the objective's
@@ -505,25 +434,14 @@ pub fn finish_with(
         // to small corners, where refinement leaves tets over it (measured: cheese 20 -> 16.6
         // degrees, dino 18.3 -> 15.8).
         keep_rho: match params.surface_mode {
-            crate::refine::SurfaceMode::Approximate => f64::INFINITY,
-            crate::refine::SurfaceMode::Keep => params.rho0,
+            SurfaceMode::Approximate => f64::INFINITY,
+            SurfaceMode::Keep => params.rho0,
         },
         ..Options::default()
     };
-    let before = (report.min_dihedral_deg, report.max_dihedral_deg);
     let (out, stats) = improve_with(&mesh, input, &opts, slide);
     check_no_degenerate(&out)?;
-    match remeasure {
-        Some(measure) => measure(&out, report)?,
-        None if stats.changed() => update_report(report, &out),
-        None => {}
-    }
-    report.delaunay = !stats.changed();
-    report.dihedral_before_improve_deg = [before.0, before.1];
-    report.seconds_improvement = stats.seconds;
-    report.seconds_total += stats.seconds;
-    report.improvement = stats;
-    Ok(out)
+    Ok((out, stats))
 }
 
 #[cfg(test)]

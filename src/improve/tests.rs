@@ -116,7 +116,7 @@ fn improver_for(mesh: &TetMesh) -> Improver<'static> {
         cons: vec![Constraint::Fixed; mesh.vertices.len()],
         normals: vec![],
         slide: None,
-        stats: Stats::default(),
+        stats: ImproveStats::default(),
         rho_vetoes: Default::default(),
         rho_yields: Default::default(),
     }
@@ -311,15 +311,14 @@ fn flat_tet_on_a_facet_is_flipped_away() {
     };
     assert!(check_no_degenerate(&mesh).is_err());
     for improve_on in [false, true] {
-        let mut report = Report::default();
-        let params = crate::refine::Params {
+        let params = Params {
             improve: improve_on,
             ..Default::default()
         };
-        let out = finish(mesh.clone(), &mut report, Some(&input), &params, None).unwrap();
-        assert_eq!(out.tets.len(), 2, "{:?}", report.improvement);
-        assert_eq!(report.improvement.boundary_flips, 1);
-        assert!(!report.delaunay);
+        let (out, stats) = finish(mesh.clone(), Some(&input), &params, None).unwrap();
+        assert_eq!(out.tets.len(), 2, "{stats:?}");
+        assert_eq!(stats.boundary_flips, 1);
+        assert!(stats.changed());
         let mut base: Vec<[u32; 3]> = out
             .boundary
             .iter()
@@ -340,10 +339,9 @@ fn flat_tet_on_a_facet_is_flipped_away() {
     }
     // Without the input description the boundary may not flip; here the interior 3-2 flip
     // of edge 1-3 removes the flat tet instead, keeping the base's triangles.
-    let mut report = Report::default();
-    let out = finish(mesh.clone(), &mut report, None, &Default::default(), None).unwrap();
+    let (out, stats) = finish(mesh.clone(), None, &Default::default(), None).unwrap();
     assert_eq!(out.boundary, mesh.boundary);
-    assert_eq!(report.improvement.edge_removals, 1);
+    assert_eq!(stats.edge_removals, 1);
     assert_eq!(out.tets.len(), 2);
 }
 
@@ -405,7 +403,7 @@ fn insertion_lifts_a_flat_tet_off_a_fold() {
         cons,
         normals,
         slide: None,
-        stats: Stats::default(),
+        stats: ImproveStats::default(),
         rho_vetoes: Default::default(),
         rho_yields: Default::default(),
     };
@@ -455,7 +453,7 @@ fn deletion_removes_a_vertex_squeezed_against_a_face() {
         cons,
         normals,
         slide: None,
-        stats: Stats::default(),
+        stats: ImproveStats::default(),
         rho_vetoes: Default::default(),
         rho_yields: Default::default(),
     };

@@ -180,7 +180,7 @@ pub fn parse_mtr(text: &str) -> Result<Vec<f64>, IoError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::refine::Spacing;
+    use crate::run::spacing::Spacing;
     use glam::DVec3;
 
     fn err_sol(text: &str, line: usize, needle: &str) {

@@ -8,7 +8,7 @@
 //! one cell; a point outside every tet searches rings of cells around its cell until no
 //! closer tet can remain.
 
-use super::Spacing;
+use crate::run::spacing::Spacing;
 use glam::{DMat3, DVec3};
 
 /// Barycentric coordinates down to this (negative) value count as inside a tet.

@@ -2,10 +2,10 @@
 //! the subsegments and each facet's 2D triangulation (its subfacets), and what every vertex
 //! lies on.
 
-use super::MeshError;
 use crate::cdt::{Change, FacetMesh};
 use crate::delaunay::{Cavity, Delaunay, Inserted};
 use crate::plc::{Plc, PlcInput};
+use crate::run::error::MeshError;
 use glam::DVec3;
 use rustc_hash::{FxHashMap, FxHashSet};
 

@@ -14,10 +14,14 @@
 //!   input had tets, and an attribute whose tets form several pieces keeps all of them.
 
 use super::mark::Unseeded;
-use super::{mesh_domain, ConstantSpacing, MeshError, Params, Report};
+use super::mesh_domain;
 use crate::geom::orient3d;
 use crate::mesh::TetMesh;
 use crate::plc::{Facet, PlcInput, Region};
+use crate::run::error::MeshError;
+use crate::run::params::Params;
+use crate::run::report::Report;
+use crate::run::spacing::ConstantSpacing;
 use crate::union_find::UnionFind;
 use glam::DVec3;
 use rustc_hash::{FxHashMap, FxHashSet};

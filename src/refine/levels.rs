@@ -16,10 +16,10 @@
 //! ([`pick_in_ball`], [`try_candidate`]).
 
 use super::outcome::{Outcome, Refusal};
-use super::MeshError;
 use crate::delaunay::{BoundaryFace, Cavity, CavityWatch, Delaunay, Probe, INFINITE};
 use crate::geom::circumsphere;
 use crate::geom::screen::{shortest_edge_sq, sliver_measures, SliverScreen};
+use crate::run::error::MeshError;
 use glam::DVec3;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;

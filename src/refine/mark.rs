@@ -4,9 +4,9 @@
 //! its component (0 = outside), so tets created later inherit it.
 
 use super::domain::{tri_key, Domain, VertexKind};
-use super::MeshError;
 use crate::delaunay::{tables::FACE, INFINITE};
 use crate::plc::{CellKind, Plc};
+use crate::run::error::MeshError;
 use crate::surface::oracle::SurfaceOracle;
 use crate::surface::InputSurface;
 use crate::union_find::UnionFind;

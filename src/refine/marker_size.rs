@@ -8,7 +8,8 @@
 //! their spacing (the caller's, or the automatic one) in [`MarkerCapped`]; the distance is the
 //! closest-point query of a [`SurfaceOracle`] on the triangles of that marker's input facets.
 
-use super::{MeshError, Spacing};
+use crate::run::error::MeshError;
+use crate::run::spacing::Spacing;
 use crate::surface::oracle::SurfaceOracle;
 use crate::surface::InputSurface;
 use glam::DVec3;
@@ -133,7 +134,7 @@ impl Spacing for MarkerCapped<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::refine::ConstantSpacing;
+    use crate::run::spacing::ConstantSpacing;
 
     fn square() -> InputSurface {
         // Two triangles of the unit square in z = 0 (marker 3), one far away (marker 1).

@@ -1,5 +1,8 @@
 //! What refining one bad element did (`Refiner::refine_tet` decides, `Refiner::run` keeps the
-//! books), and the count of bad tets left alone per reason that the report carries.
+//! books), and how a refusal is counted in the report's per-reason counts
+//! (`run::report::Refusals`).
+
+use crate::run::report::Refusals;
 
 /// What refining one bad tet did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -82,172 +85,37 @@ impl Refusal {
         )
     }
 
+    /// Counts this refusal in `counts` (its reason's count and the total).
+    pub(super) fn count(self, counts: &mut Refusals) {
+        let slot = match self {
+            Refusal::Futile => &mut counts.futile,
+            Refusal::FlatByConstruction => &mut counts.flat_by_construction,
+            Refusal::NoCircumsphere => &mut counts.no_circumsphere,
+            Refusal::FlatToRounding => &mut counts.flat_to_rounding,
+            Refusal::FarCentre => &mut counts.far_centre,
+            Refusal::CentreOutsideDomain => &mut counts.centre_outside_domain,
+            Refusal::NearSmallAngle => &mut counts.near_small_angle,
+            Refusal::Duplicate => &mut counts.duplicate,
+            Refusal::Cascade => &mut counts.cascade,
+            Refusal::CascadeNearSmallAngle => &mut counts.cascade_near_small_angle,
+            Refusal::CentroidCascade => &mut counts.centroid_cascade,
+            Refusal::FlatSubfacet => &mut counts.flat_subfacet,
+            Refusal::SubfacetCentreOutside => &mut counts.subfacet_centre_outside,
+        };
+        *slot += 1;
+        counts.total += 1;
+    }
+
     /// Whether the tet is left at once when looked at again ([`Refusal::Futile`]).
     pub(super) fn remembered(self) -> bool {
         matches!(self, Refusal::Cascade | Refusal::CascadeNearSmallAngle)
     }
 }
 
-/// How many times refinement left a bad tet as it was, per reason (a tet looked at again and
-/// left again counts again; many are removed later by other insertions), and how many bad
-/// tets a budget left queued. Keep mode and existing meshes; zero in approximate mode.
-#[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize)]
-pub struct Refusals {
-    /// The sum of all the counts below.
-    pub total: usize,
-    /// Refused for a cascade before, left at once when looked at again.
-    pub futile: usize,
-    /// Flat by construction (three vertices on one segment, four in one facet).
-    pub flat_by_construction: usize,
-    /// No circumsphere in floating point.
-    pub no_circumsphere: usize,
-    /// Flat to rounding (the computed circumcentre is outside its own circumsphere).
-    pub flat_to_rounding: usize,
-    /// Circumcentre outside the domain's box and far away.
-    pub far_centre: usize,
-    /// Deferred, and its circumcentre outside the domain.
-    pub centre_outside_domain: usize,
-    /// Within a small input angle's influence.
-    pub near_small_angle: usize,
-    /// The point to insert was a vertex already.
-    pub duplicate: usize,
-    /// The circumcentre encroaches a much smaller boundary element (a cascade).
-    pub cascade: usize,
-    /// The same, the element within a small angle's influence.
-    pub cascade_near_small_angle: usize,
-    /// Size-bad next to a small angle, its centroid breaking a much smaller boundary element.
-    pub centroid_cascade: usize,
-    /// The subfacet to split has no circumcentre.
-    pub flat_subfacet: usize,
-    /// The subfacet's circumcentre lies outside its facet.
-    pub subfacet_centre_outside: usize,
-    /// Bad tets still queued when a budget (vertices, or boundary splits) stopped refinement.
-    pub budget: usize,
-}
-
-impl Refusals {
-    /// Counts one refusal.
-    pub(super) fn count(&mut self, r: Refusal) {
-        *self.slot(r) += 1;
-        self.total += 1;
-    }
-
-    /// Counts `n` bad tets left queued by a budget.
-    pub(super) fn count_budget(&mut self, n: usize) {
-        self.budget += n;
-        self.total += n;
-    }
-
-    /// The total and the reasons counted, e.g. "1750 (near_small_angle 1585, cascade 165)".
-    pub fn summary(&self) -> String {
-        let reasons: Vec<String> = self
-            .counts()
-            .iter()
-            .filter(|(_, n)| *n > 0)
-            .map(|(name, n)| format!("{name} {n}"))
-            .collect();
-        if reasons.is_empty() {
-            self.total.to_string()
-        } else {
-            format!("{} ({})", self.total, reasons.join(", "))
-        }
-    }
-
-    fn slot(&mut self, r: Refusal) -> &mut usize {
-        match r {
-            Refusal::Futile => &mut self.futile,
-            Refusal::FlatByConstruction => &mut self.flat_by_construction,
-            Refusal::NoCircumsphere => &mut self.no_circumsphere,
-            Refusal::FlatToRounding => &mut self.flat_to_rounding,
-            Refusal::FarCentre => &mut self.far_centre,
-            Refusal::CentreOutsideDomain => &mut self.centre_outside_domain,
-            Refusal::NearSmallAngle => &mut self.near_small_angle,
-            Refusal::Duplicate => &mut self.duplicate,
-            Refusal::Cascade => &mut self.cascade,
-            Refusal::CascadeNearSmallAngle => &mut self.cascade_near_small_angle,
-            Refusal::CentroidCascade => &mut self.centroid_cascade,
-            Refusal::FlatSubfacet => &mut self.flat_subfacet,
-            Refusal::SubfacetCentreOutside => &mut self.subfacet_centre_outside,
-        }
-    }
-
-    /// Adds another pass's counts.
-    pub fn add(&mut self, o: &Refusals) {
-        let Refusals {
-            total,
-            futile,
-            flat_by_construction,
-            no_circumsphere,
-            flat_to_rounding,
-            far_centre,
-            centre_outside_domain,
-            near_small_angle,
-            duplicate,
-            cascade,
-            cascade_near_small_angle,
-            centroid_cascade,
-            flat_subfacet,
-            subfacet_centre_outside,
-            budget,
-        } = o;
-        self.total += total;
-        self.futile += futile;
-        self.flat_by_construction += flat_by_construction;
-        self.no_circumsphere += no_circumsphere;
-        self.flat_to_rounding += flat_to_rounding;
-        self.far_centre += far_centre;
-        self.centre_outside_domain += centre_outside_domain;
-        self.near_small_angle += near_small_angle;
-        self.duplicate += duplicate;
-        self.cascade += cascade;
-        self.cascade_near_small_angle += cascade_near_small_angle;
-        self.centroid_cascade += centroid_cascade;
-        self.flat_subfacet += flat_subfacet;
-        self.subfacet_centre_outside += subfacet_centre_outside;
-        self.budget += budget;
-    }
-
-    /// The counts by reason (without the total), named as in the JSON report.
-    pub fn counts(&self) -> [(&'static str, usize); 14] {
-        let Refusals {
-            total: _,
-            futile,
-            flat_by_construction,
-            no_circumsphere,
-            flat_to_rounding,
-            far_centre,
-            centre_outside_domain,
-            near_small_angle,
-            duplicate,
-            cascade,
-            cascade_near_small_angle,
-            centroid_cascade,
-            flat_subfacet,
-            subfacet_centre_outside,
-            budget,
-        } = *self;
-        [
-            ("futile", futile),
-            ("flat_by_construction", flat_by_construction),
-            ("no_circumsphere", no_circumsphere),
-            ("flat_to_rounding", flat_to_rounding),
-            ("far_centre", far_centre),
-            ("centre_outside_domain", centre_outside_domain),
-            ("near_small_angle", near_small_angle),
-            ("duplicate", duplicate),
-            ("cascade", cascade),
-            ("cascade_near_small_angle", cascade_near_small_angle),
-            ("centroid_cascade", centroid_cascade),
-            ("flat_subfacet", flat_subfacet),
-            ("subfacet_centre_outside", subfacet_centre_outside),
-            ("budget", budget),
-        ]
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::run::report::Refusals;
 
     const ALL: [Refusal; 13] = [
         Refusal::Futile,
@@ -272,7 +140,7 @@ mod tests {
         let mut r = Refusals::default();
         for (k, &reason) in ALL.iter().enumerate() {
             for _ in 0..=k {
-                r.count(reason);
+                reason.count(&mut r);
             }
         }
         r.count_budget(ALL.len() + 1);

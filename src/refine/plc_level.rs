@@ -11,9 +11,9 @@ use super::domain::{seg_key, tri_key, Domain, VertexKind};
 use super::levels::{try_candidate, Conflict, FacetLevel, Picker, Request};
 use super::outcome::{BoundaryKind, Outcome, Refusal};
 use super::recover::{Settled, MAX_RECOVERY_SPLITS};
-use super::MeshError;
 use crate::delaunay::{tables::FACE, Cavity, Delaunay, INFINITE};
 use crate::geom::{diametric_ball, equatorial_ball, tri_circumcenter};
+use crate::run::error::MeshError;
 use glam::DVec3;
 use rand::Rng;
 

@@ -14,13 +14,16 @@
 use super::domain::{Domain, VertexKind};
 use super::levels::{pick_in_ball, Conflict, FacetLevel, Picker, Request};
 use super::mark::Regions;
-use super::outcome::{Outcome, Refusal, Refusals};
+use super::outcome::{Outcome, Refusal};
 use super::plc_level::Boundary;
 use super::recover::Settled;
-use super::{MeshError, Params, Spacing};
 use crate::delaunay::{Cavity, Probe};
 use crate::geom::screen::{longest_edge_direct as longest_edge, sliver_measures};
 use crate::geom::{circum_offset_crossed, circumsphere, insphere, orient3d};
+use crate::run::error::MeshError;
+use crate::run::params::Params;
+use crate::run::report::Refusals;
+use crate::run::spacing::Spacing;
 use glam::DVec3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -418,7 +421,7 @@ impl<'a> Refiner<'a> {
     fn record(&mut self, bad: Bad, outcome: Outcome, n_before: usize) -> Result<bool, MeshError> {
         match outcome {
             Outcome::Refused(reason) => {
-                self.refusals.count(reason);
+                reason.count(&mut self.refusals);
                 if reason.remembered() {
                     self.futile.insert(sorted4(bad.verts));
                 }

@@ -6,9 +6,9 @@
 //! triangulation (checked exactly, combinatorially), so the boundary is conforming.
 
 use super::domain::{seg_key, tri_key, Domain};
-use super::MeshError;
 use crate::delaunay::{tables::FACE, INFINITE};
 use crate::geom::{diametric_ball, equatorial_ball, tri_circumcenter};
+use crate::run::error::MeshError;
 use glam::DVec3;
 
 /// Safety net against a non-terminating recovery (e.g. an input angle so small that even

@@ -3,7 +3,7 @@
 //! feature size), sampled on a grid: f(x) = min over boundary vertices v of h_v + alpha |x - v|.
 
 use super::domain::Domain;
-use super::Spacing;
+use crate::run::spacing::Spacing;
 use glam::DVec3;
 
 /// Grading: how fast the automatic spacing may grow away from the boundary.

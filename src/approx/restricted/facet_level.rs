@@ -11,7 +11,7 @@ use crate::delaunay::tables::FACE;
 use crate::delaunay::{Cavity, Delaunay, INFINITE};
 use crate::refine::levels::{Conflict, FacetLevel, Picker, Request};
 use crate::refine::outcome::{BoundaryKind, Outcome};
-use crate::refine::MeshError;
+use crate::run::error::MeshError;
 
 /// What a cell's point would break.
 #[derive(Debug)]
@@ -106,7 +106,7 @@ mod tests {
     use crate::approx::curves::FeatureCurves;
     use crate::delaunay::Probe;
     use crate::io::{read_plc, ReadOptions};
-    use crate::refine::ConstantSpacing;
+    use crate::run::spacing::ConstantSpacing;
     use crate::surface::features::{FeatureParams, Features};
     use crate::surface::oracle::SurfaceOracle;
     use crate::surface::InputSurface;

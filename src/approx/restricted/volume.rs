@@ -19,14 +19,15 @@ use crate::geom::screen::{shortest_edge_sq, sliver_measures};
 use crate::refine::levels::{
     pick_in_ball, Conflict, FacetLevel, GiveUp, Picker, Request, SliverBounds,
 };
-use crate::refine::{AutoSpacing, MarkerCapped, Spacing};
+use crate::refine::{AutoSpacing, MarkerCapped};
+use crate::run::spacing::Spacing;
 use glam::DVec3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rustc_hash::FxHashMap;
 use std::collections::VecDeque;
 
-/// What the cell level aims for (from `refine::Params`).
+/// What the cell level aims for (from `run::params::Params`).
 #[derive(Debug, Clone, Copy)]
 pub struct VolumeCriteria {
     pub rho0: f64,
@@ -307,7 +308,7 @@ impl SurfaceMesher<'_> {
     /// Runs both levels until no bad facet, subsegment or cell is left (or a budget stops it).
     pub(super) fn refine_volume(
         &mut self,
-        progress: &mut Option<crate::refine::Progress>,
+        progress: &mut Option<crate::run::progress::Progress>,
     ) -> Option<String> {
         let mut steps = 0usize;
         loop {

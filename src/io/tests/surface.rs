@@ -139,7 +139,9 @@ fn every_off_model_reads_the_same_as_ply_and_obj() {
 /// exactly the mesh of their `.off` (coplanar faces merged, as the CLI reads surfaces).
 #[test]
 fn ply_and_obj_versions_mesh_like_the_off() {
-    use crate::refine::{mesh, ConstantSpacing, Params};
+    use crate::refine::mesh;
+    use crate::run::params::Params;
+    use crate::run::spacing::ConstantSpacing;
     let dir = TempDir::new("surface");
     for (name, h) in [("cube", 0.25), ("cross", 0.04)] {
         let off_path = model(&format!("off/{name}.off"));
@@ -164,7 +166,7 @@ fn ply_and_obj_versions_mesh_like_the_off() {
             let input = read_plc(path, &opts(true)).unwrap();
             let (got, r) = mesh(&input, &params, Some(&h), None).unwrap();
             assert_eq!(got, want, "{}", path.display());
-            let untimed = |r: &crate::refine::Report| crate::refine::Report {
+            let untimed = |r: &crate::run::report::Report| crate::run::report::Report {
                 seconds_recovery: 0.0,
                 seconds_refinement: 0.0,
                 seconds_total: 0.0,

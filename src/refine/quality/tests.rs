@@ -49,7 +49,7 @@ fn cube_with_unsettled_subsegment() -> (Domain, Regions, u32) {
 #[test]
 fn encroached_element_gone_after_resettling_is_not_split() {
     let params = Params::default();
-    let spacing = super::super::ConstantSpacing(10.0);
+    let spacing = crate::run::spacing::ConstantSpacing(10.0);
     // What restoring the boundary alone does.
     let (mut dom, regions, t) = cube_with_unsettled_subsegment();
     assert_eq!(
@@ -101,7 +101,10 @@ fn refusals_are_counted_and_cascades_remembered() {
         tet: t,
         verts: dom.dt.tet(t),
     };
-    let (params, spacing) = (Params::default(), super::super::ConstantSpacing(10.0));
+    let (params, spacing) = (
+        Params::default(),
+        crate::run::spacing::ConstantSpacing(10.0),
+    );
     let mut refiner = Refiner::new(&mut dom, &params, &spacing, &regions);
     let n = refiner.dom.dt.num_vertices();
     let conflict = refiner
@@ -170,7 +173,7 @@ fn plc_facet_level_conflicts_follow_the_request() {
     use super::super::levels::pick_in_ball;
     let (mut dom, regions) = settled_cube();
     let params = Params::default();
-    let spacing = super::super::ConstantSpacing(0.3);
+    let spacing = crate::run::spacing::ConstantSpacing(0.3);
     Refiner::new(&mut dom, &params, &spacing, &regions)
         .run(&mut |_| true)
         .unwrap();
