@@ -28,8 +28,9 @@ pub use spacing::SpacingChoice;
 
 pub use crate::mesh::TetMesh;
 pub use crate::plc::PlcInput;
+pub use crate::quadratic::QuadraticReport;
 pub use crate::run::error::MeshError;
-pub use crate::run::report::Report;
+pub use crate::run::report::{ImproveStats, Refusals, RegionReport, Report, SurfaceReport};
 pub use crate::run::spacing::{ConstantSpacing, FnSpacing, MinSpacing, Spacing};
 
 #[cfg(test)]

@@ -1,14 +1,13 @@
 //! `slivermesh mesh`: domain file in, quality mesh out, report printed; and the built-in demo.
 
 use indicatif::{ProgressBar, ProgressStyle};
+use slivermesh::api::{
+    MeshOutput, Mesher, Params, QuadraticReport, Report, SurfaceMode, SurfaceReport,
+};
 use slivermesh::geom::TetQuality;
 use slivermesh::io::{self, ReadOptions};
 use slivermesh::mesh::{QuadraticNodes, TetMesh};
-use slivermesh::pipeline;
 use slivermesh::plc::{Facet, PlcInput, Region};
-use slivermesh::run::params::{Params, SurfaceMode};
-use slivermesh::run::report::{Report, SurfaceReport};
-use slivermesh::run::spacing::{ConstantSpacing, FnSpacing, Spacing};
 use slivermesh::DVec3;
 use std::io::IsTerminal;
 use std::path::Path;
@@ -214,20 +213,14 @@ pub fn run_mesh(
     if opts.size.is_some() && opts.size_field.is_some() {
         return Err("--size and --size-field cannot be used together".to_string());
     }
-    let constant = opts.size.map(ConstantSpacing);
     let field = match &opts.size_field {
         Some(p) => Some(io::sizefield::read_size_field(p)?),
         None => None,
     };
-    let spacing = match (&constant, &field) {
-        (Some(c), _) => Some(c as &dyn Spacing),
-        (None, Some(f)) => Some(f as &dyn Spacing),
-        (None, None) => None,
-    };
     let is_mesh = input
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("mesh"));
-    let (mesh, quadratic, report) = if is_mesh {
+    let mut mesher = if is_mesh {
         if opts.surface == Some(SurfaceArg::Approximate) {
             return Err(format!(
                 "{}: --surface approximate does not apply to an existing mesh (.mesh): its \
@@ -236,7 +229,11 @@ pub fn run_mesh(
             ));
         }
         let existing = io::read_mesh(input).map_err(|e| e.to_string())?;
-        pipeline::remove_slivers(&existing, &params).map_err(|e| e.to_string())?
+        let mut mesher = Mesher::new().with_params(params);
+        mesher
+            .set_existing_mesh(existing)
+            .map_err(|e| e.to_string())?;
+        mesher
     } else {
         let merge = !opts.no_merge && io::is_surface_file(input);
         let plc = io::read_plc(
@@ -246,8 +243,20 @@ pub fn run_mesh(
             },
         )
         .map_err(|e| e.to_string())?;
-        mesh_with_progress(&plc, &params, spacing)?
+        Mesher::from_plc(plc)
+            .map_err(|e| e.to_string())?
+            .with_params(params)
     };
+    if let Some(h) = opts.size {
+        mesher.set_spacing_constant(h).map_err(|e| e.to_string())?;
+    } else if let Some(f) = field {
+        mesher.set_spacing(f);
+    }
+    let MeshOutput {
+        mesh,
+        quadratic,
+        report,
+    } = mesh_with_progress(mesher)?;
     let written = Written {
         mesh: &mesh,
         quadratic: quadratic.as_ref(),
@@ -256,12 +265,9 @@ pub fn run_mesh(
     finish(written, &report, output, stats_json, quality_svg)
 }
 
-/// `pipeline::mesh` (the surface mode, refinement, improvement) with a spinner on a terminal.
-fn mesh_with_progress(
-    plc: &PlcInput,
-    params: &Params,
-    spacing: Option<&dyn Spacing>,
-) -> Result<(TetMesh, Option<QuadraticNodes>, Report), String> {
+/// Runs `mesher` (`api::Mesher::refine_with`: the surface mode, refinement and improvement, or
+/// an existing mesh's sliver removal) with a spinner on a terminal, and takes its output.
+fn mesh_with_progress(mut mesher: Mesher) -> Result<MeshOutput, String> {
     let bar = if std::io::stderr().is_terminal() {
         let b = ProgressBar::new_spinner();
         b.set_style(
@@ -279,11 +285,14 @@ fn mesh_with_progress(
         }
         true
     };
-    let r = pipeline::mesh(plc, params, spacing, Some(&mut progress));
+    let r = mesher.refine_with(None, Some(&mut progress)).map(|_| ());
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    r.map_err(|e| e.to_string())
+    r.map_err(|e| e.to_string())?;
+    Ok(mesher
+        .take_output()
+        .expect("a successful refine keeps its output"))
 }
 
 /// The output as written: the tets, their mid-edge nodes with `--order 2`, and `--binary`.
@@ -410,7 +419,7 @@ fn surface_table(s: &SurfaceReport) -> String {
 }
 
 /// The report's "quadratic" section (`--order 2`).
-fn quadratic_table(q: &slivermesh::quadratic::QuadraticReport) -> String {
+fn quadratic_table(q: &QuadraticReport) -> String {
     format!(
         "ten-node tets (--order 2)\n  \
          mid-edge nodes                   {}\n  \
@@ -513,10 +522,9 @@ pub fn demo_model() -> PlcInput {
 /// `slivermesh` with no arguments: meshes the built-in model, writes slivermesh-demo.vtu.
 pub fn run_demo() -> Result<(), String> {
     println!("slivermesh demo: two-material 2x1x1 box, spacing f = 0.02 + 0.1 |x|, rho0 = 2");
-    let plc = demo_model();
-    let f = FnSpacing(|p: DVec3| 0.02 + 0.1 * p.length());
-    let params = Params::default();
-    let (mesh, _, report) = mesh_with_progress(&plc, &params, Some(&f))?;
+    let mut mesher = Mesher::from_plc(demo_model()).map_err(|e| e.to_string())?;
+    mesher.set_spacing_fn(|p: DVec3| 0.02 + 0.1 * p.length());
+    let MeshOutput { mesh, report, .. } = mesh_with_progress(mesher)?;
     let written = Written {
         mesh: &mesh,
         quadratic: None,
