@@ -9,25 +9,48 @@
 //! `io` (file formats) reads and writes for `api`; `mesh` holds the output model shared by
 //! writers and meshers. `tests/layering.rs` checks the imports of `run`, `refine` and
 //! `improve`. See ARCHITECTURE.md.
+//!
+//! The documented Rust API is [`api`] and the types it names, which it re-exports; the other
+//! public modules are `#[doc(hidden)]` internals (for the `slivermesh` binary, the integration
+//! tests, the examples and the benchmarks), and `approx`, `quadratic` and `union_find` are
+//! private.
 
 #![deny(clippy::undocumented_unsafe_blocks)]
 
 pub mod api;
-pub mod approx;
+
+// Internals: not part of the documented Rust API (that is `api` and the types it names, which
+// it re-exports). Public only for the `slivermesh` binary, the integration tests, the examples
+// and the benchmarks; `ffi` is the C ABI (include/slivermesh.h).
+#[doc(hidden)]
 pub mod cdt;
+#[doc(hidden)]
 pub mod delaunay;
+#[doc(hidden)]
 pub mod ffi;
+#[doc(hidden)]
 pub mod geom;
+#[doc(hidden)]
 pub mod improve;
+#[doc(hidden)]
 pub mod io;
+#[doc(hidden)]
 pub mod mesh;
+#[doc(hidden)]
 pub mod pipeline;
+#[doc(hidden)]
 pub mod plc;
-pub mod quadratic;
+#[doc(hidden)]
 pub mod quality;
+#[doc(hidden)]
 pub mod refine;
+#[doc(hidden)]
 pub mod run;
+#[doc(hidden)]
 pub mod surface;
+
+mod approx;
+mod quadratic;
 mod union_find;
 
 pub use glam::DVec3;

@@ -20,8 +20,6 @@ mod restricted;
 #[cfg(test)]
 mod tests;
 
-pub use curves::SMALL_CORNER_DEG;
-
 use crate::mesh::{QuadraticNodes, TetMesh};
 use crate::plc::{Facet, PlcInput};
 use crate::refine::{AutoSpacing, MarkerCapped, MarkerCaps};

@@ -1,8 +1,8 @@
 //! Incremental 3D Delaunay tetrahedralization (Bowyer–Watson) over flat arrays.
 //!
 //! Algorithms: BRIO + Hilbert insertion order ([`hilbert`]); stochastic visibility walk from a
-//! hint ([`locate`]); conflict region ("cavity") grown with the exact in-sphere test and
-//! retriangulated as a star from the new point ([`cavity`]); symbolic perturbation by vertex id
+//! hint (`locate`); conflict region ("cavity") grown with the exact in-sphere test and
+//! retriangulated as a star from the new point (`cavity`); symbolic perturbation by vertex id
 //! for cospherical ties (`geom::insphere_sos`), so grids and other degenerate inputs give one
 //! consistent triangulation. The hull is closed by "ghost" tets that carry the vertex at
 //! infinity ([`INFINITE`]).

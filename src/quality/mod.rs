@@ -8,10 +8,10 @@
 //! rho = aspect = +∞, sigma = 0). "Below 5°" counts tets whose smallest dihedral angle is
 //! < 5°; "above 160°" those whose largest is > 160°.
 //!
-//! - [`measure`] → [`MeshQuality`] (counts, extremes, percentiles, a 5° histogram of the
-//!   per-tet minimum dihedral angle); [`dihedral_histogram`]: all six angles per tet, 1° bins;
-//! - [`table`], [`histogram_text`], [`compare_table`]: the text the CLI prints;
-//! - [`svg`]: the histogram picture with the 5/10/15/20° lines.
+//! - `measure` → [`MeshQuality`] (counts, extremes, percentiles, a 5° histogram of the
+//!   per-tet minimum dihedral angle); `dihedral_histogram`: all six angles per tet, 1° bins;
+//! - `table`, `histogram_text`, `compare_table`: the text the CLI prints;
+//! - `svg`: the histogram picture with the 5/10/15/20° lines.
 
 mod measure;
 mod svg;

@@ -5,12 +5,12 @@
 //!   faces the file leaves out that the result needs: faces of exactly one tet (the boundary
 //!   of the tet set) and faces between tets of different region attributes (interfaces). Those
 //!   get marker 0. Every listed triangle must be a face of a tet. Flat patches of triangles with
-//!   one marker become polygons again where they can (see [`merge_flat_patches`]).
+//!   one marker become polygons again where they can (see `merge_flat_patches`).
 //! - Seeds: the facets cut the tets into pieces (tets joined through faces that are not
 //!   facets). Each piece gets one region seed with its attribute, at a tet centroid checked to
 //!   lie strictly inside that tet with exact predicates, so it is on no facet. Components of the
 //!   new triangulation with no seed — volume holes (cavities) and, for a non-convex mesh, the
-//!   outside — are removed ([`Unseeded::Hole`]). So tets of the result exist exactly where the
+//!   outside — are removed (`Unseeded::Hole`). So tets of the result exist exactly where the
 //!   input had tets, and an attribute whose tets form several pieces keeps all of them.
 
 use super::mark::Unseeded;

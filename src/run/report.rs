@@ -1,6 +1,6 @@
 //! The figures a run reports: the whole run's [`Report`] and the stage reports it is made of
 //! (refinement's [`Refusals`], the improvement's [`ImproveStats`], the approximate mode's
-//! [`SurfaceReport`], the regions' [`RegionReport`]), and [`Shapes`], the shape figures that
+//! [`SurfaceReport`], the regions' [`RegionReport`]), and `Shapes`, the shape figures that
 //! refinement's measure and the improvement's re-measure take the same way. The stages fill
 //! their parts; `pipeline` (and `approx` for its mode) puts them together.
 
@@ -410,8 +410,8 @@ impl Report {
         self.input_interface_area = input.interface_area;
     }
 
-    /// Takes the figures [`measure`] fills in (counts, shapes, sizes, bad tets near small
-    /// angles) from `m`, a report it made; the rest of `self` stays.
+    /// Takes the figures `refine::report::measure` fills in (counts, shapes, sizes, bad tets
+    /// near small angles) from `m`, a report it made; the rest of `self` stays.
     pub fn take_measures(&mut self, m: Report) {
         self.n_vertices = m.n_vertices;
         self.n_tets = m.n_tets;

@@ -38,7 +38,7 @@ pub fn samples(s: &InputSurface, spacing: f64) -> Vec<DVec3> {
 /// A triangle is sampled on a barycentric grid of step at most `spacing` along each edge: no
 /// point of it is farther than `spacing` / sqrt(3) from a sample. A long thin triangle, where
 /// that grid would be mostly redundant points along its length, is sampled in rows instead
-/// (see [`Rows`]), with the same guarantee and fewer samples.
+/// (see `Rows`), with the same guarantee and fewer samples.
 ///
 /// Each sample is taken once: a vertex by the first triangle using it, an edge's grid points
 /// by the first triangle cutting it into as many pieces (its neighbour mostly does: the two
