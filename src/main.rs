@@ -10,11 +10,10 @@
 
 mod cli;
 
-// The refinement makes hundreds of thousands of small, short-lived allocations (cavities, crossing
-// lists, queues), which mimalloc serves in fewer instructions than glibc's malloc. Set here only:
-// the library uses its caller's allocator.
+// mimalloc for the many small allocations, the system allocator for arrays of tens of megabytes
+// (cli/alloc.rs says why). Set here only: the library uses its caller's allocator.
 #[global_allocator]
-static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
+static GLOBAL: cli::alloc::LargeToSystem = cli::alloc::LargeToSystem;
 
 use clap::{Parser, Subcommand};
 use cli::gen::{self, Kind};

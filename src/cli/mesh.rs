@@ -318,17 +318,24 @@ fn finish(
     if let Some(q) = &report.quadratic {
         println!("{}", quadratic_table(q));
     }
-    // Every tet measured once, for the .vtu's cell data and the quality table.
-    let per_tet = slivermesh::quality::per_tet(mesh).ok();
+    // Every tet measured once when the .vtu's cell data needs the measures (the quality table
+    // reuses them); otherwise the table measures as it goes, without a per-tet copy.
+    let per_tet = output
+        .filter(|p| has_cell_data(p))
+        .and_then(|_| slivermesh::quality::per_tet(mesh).ok());
     if let Some(path) = output {
         write_with_quality(path, written, per_tet.as_deref())?;
         println!("wrote {}", path.display());
     }
-    // After writing, so that the peak covers the whole run.
+    // Measured on the mesh as written, the table `slivermesh quality` prints for that file.
+    let name = output.map_or("the output mesh".to_string(), |p| p.display().to_string());
+    super::quality::report_output(mesh, &name, quality_svg, per_tet.as_deref())?;
+    drop(per_tet);
+    // Last, so that the peak covers the whole run: meshing, writing and measuring.
     let peak = super::rss::peak_rss_bytes();
     if let Some(bytes) = peak {
         println!(
-            "peak memory: {:.1} MB, {:.0} bytes a tet",
+            "\npeak memory: {:.1} MB, {:.0} bytes a tet",
             bytes as f64 / 1e6,
             bytes as f64 / mesh.tets.len().max(1) as f64
         );
@@ -343,9 +350,13 @@ fn finish(
         let text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())?;
         std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))?;
     }
-    // Measured on the mesh as written, the table `slivermesh quality` prints for that file.
-    let name = output.map_or("the output mesh".to_string(), |p| p.display().to_string());
-    super::quality::report_output(mesh, &name, quality_svg, per_tet.as_deref())
+    Ok(())
+}
+
+/// Whether the output format has a place for per-tet cell data (.vtu).
+fn has_cell_data(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("vtu"))
 }
 
 /// The report's "surface" section (approximate mode), in the style of `Report::table`.
@@ -451,10 +462,7 @@ pub fn write_with_quality(
         binary,
     } = written;
     // Only .vtu has a place for cell data: measuring every tet for another format is wasted.
-    if !path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("vtu"))
-    {
+    if !has_cell_data(path) {
         return io::write_output(path, mesh, quadratic, &[], binary).map_err(|e| e.to_string());
     }
     let measured;

@@ -1,5 +1,6 @@
 //! Binary-private parts of the `slivermesh` command line.
 
+pub mod alloc;
 pub mod gen;
 pub mod mesh;
 pub mod quality;

@@ -145,7 +145,31 @@ pub fn improve_with(
 ) -> (TetMesh, ImproveStats) {
     let start = std::time::Instant::now();
     let objective = quality::Objective::new(opts.target_deg, opts.max_rho);
-    let mut w = Work::new(mesh, objective);
+    improve_work(Work::new(mesh, objective), input, opts, slide, start)
+}
+
+/// [`improve_with`] on a mesh it owns: the mesh is freed once its working copy is built, so
+/// the two are not held together with the output.
+fn improve_owned(
+    mesh: TetMesh,
+    input: Option<&PlcInput>,
+    opts: &Options,
+    slide: Option<&dyn SurfaceSlide>,
+) -> (TetMesh, ImproveStats) {
+    let start = std::time::Instant::now();
+    let objective = quality::Objective::new(opts.target_deg, opts.max_rho);
+    let w = Work::new(&mesh, objective);
+    drop(mesh);
+    improve_work(w, input, opts, slide, start)
+}
+
+fn improve_work(
+    mut w: Work,
+    input: Option<&PlcInput>,
+    opts: &Options,
+    slide: Option<&dyn SurfaceSlide>,
+    start: std::time::Instant,
+) -> (TetMesh, ImproveStats) {
     w.set_rho_limit(opts.keep_rho);
     let (mut cons, normals) = constraints::classify(&mut w, input);
     if let Some(s) = slide {
@@ -169,7 +193,7 @@ pub fn improve_with(
     im.stats.rho_vetoes = im.rho_vetoes.get();
     im.stats.rho_yields = im.rho_yields.get();
     im.stats.seconds = start.elapsed().as_secs_f64();
-    (im.w.to_mesh(), im.stats)
+    (im.w.into_mesh(), im.stats)
 }
 
 impl Improver<'_> {
@@ -439,7 +463,7 @@ pub fn finish(
         },
         ..Options::default()
     };
-    let (out, stats) = improve_with(&mesh, input, &opts, slide);
+    let (out, stats) = improve_owned(mesh, input, &opts, slide);
     check_no_degenerate(&out)?;
     Ok((out, stats))
 }

@@ -361,6 +361,19 @@ impl Work {
         (out, n)
     }
 
+    /// [`Work::to_mesh`], freeing the stars, maps and measures first: the output is built
+    /// while only the tets are still held.
+    pub fn into_mesh(mut self) -> TetMesh {
+        self.star = Vec::new();
+        self.bstar = Vec::new();
+        self.bmap = FxHashMap::default();
+        self.flat_edges = FxHashSet::default();
+        self.q = Vec::new();
+        self.rho_exempt = Vec::new();
+        self.free = Vec::new();
+        self.to_mesh()
+    }
+
     /// Back to a `TetMesh`: alive tets in slot order, boundary triangles in their order. The
     /// deleted vertices are dropped (later ones move down; the input's vertices, which are
     /// never deleted and come first, keep their ids).
@@ -382,6 +395,9 @@ impl Work {
             boundary_markers: self.bmarker.clone(),
             ..Default::default()
         };
+        let n_alive = self.alive.iter().filter(|&&a| a).count();
+        m.tets.reserve_exact(n_alive);
+        m.tet_regions.reserve_exact(n_alive);
         for (i, t) in self.tets.iter().enumerate() {
             if self.alive[i] {
                 m.tets.push(t.map(|v| new_id[v as usize]));

@@ -306,11 +306,12 @@ fn mesh_figures_match_a_naive_recomputation() {
     let sigmas = sorted(&|r| r.sigma);
     let aspects = sorted(&|r| r.aspect);
     close(q.max_rho, *rhos.last().unwrap(), 1e-6);
-    close(q.median_rho, pct(&rhos, 50.0), 1e-8);
+    // The percentiles are taken from f32 copies (7 digits).
+    close(q.median_rho, pct(&rhos, 50.0), 1e-6);
     close(q.min_sigma, sigmas[0], 1e-6);
-    close(q.median_sigma, pct(&sigmas, 50.0), 1e-8);
+    close(q.median_sigma, pct(&sigmas, 50.0), 1e-6);
     close(q.max_aspect, *aspects.last().unwrap(), 1e-6);
-    close(q.median_aspect, pct(&aspects, 50.0), 1e-8);
+    close(q.median_aspect, pct(&aspects, 50.0), 1e-6);
     for (k, thr) in BELOW_DEG.iter().enumerate() {
         let n = mins.iter().filter(|&&x| x < *thr).count();
         assert_eq!(q.tets_below_deg[k], n, "below {thr}");

@@ -39,6 +39,9 @@ impl Domain {
         let flat = self.flat_tets_on_facets();
         let dropped: FxHashSet<u32> = flat.iter().map(|f| f.tet).collect();
         let replaced: FxHashSet<[u32; 3]> = flat.iter().flat_map(|f| f.subfacets).collect();
+        // At most every finite tet: reserved once instead of doubling (the peak of a big run).
+        mesh.tets.reserve_exact(self.dt.num_finite_tets());
+        mesh.tet_regions.reserve_exact(self.dt.num_finite_tets());
         for t in self.dt.finite_tet_ids() {
             let tag = self.dt.tag(t);
             if tag != 0 && !dropped.contains(&t) {

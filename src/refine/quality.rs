@@ -28,7 +28,6 @@ use glam::DVec3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rustc_hash::FxHashSet;
-use std::cmp::Ordering;
 use std::collections::VecDeque;
 
 /// Badness classes, in refinement priority order.
@@ -36,31 +35,14 @@ const SIZE: u8 = 2;
 const RATIO: u8 = 1;
 const SLIVER: u8 = 0;
 
-#[derive(Debug, Clone, Copy)]
+/// A queued bad tet: its class (which queue) and the tet as it was when judged (a tet id is
+/// reused once the tet is gone, so the vertices tell whether it is still the same tet). 24
+/// bytes: the queues hold up to about one entry per tet of the final mesh.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 struct Bad {
     class: u8,
-    badness: f64,
     tet: u32,
     verts: [u32; 4],
-}
-impl PartialEq for Bad {
-    fn eq(&self, o: &Self) -> bool {
-        self.cmp(o) == Ordering::Equal
-    }
-}
-impl Eq for Bad {}
-impl PartialOrd for Bad {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
-}
-impl Ord for Bad {
-    fn cmp(&self, o: &Self) -> Ordering {
-        self.class
-            .cmp(&o.class)
-            .then(self.badness.total_cmp(&o.badness))
-            .then(o.verts.cmp(&self.verts))
-    }
 }
 
 /// A tet's classification before its spacing is known ([`Refiner::prepare_classify`]).
@@ -226,7 +208,6 @@ impl<'a> Refiner<'a> {
         let Some(offset) = circum_offset_crossed([vw, wu, uv], lu, det) else {
             return Step::Done(Some(Bad {
                 class: SLIVER,
-                badness: f64::INFINITY,
                 tet: t,
                 verts,
             }));
@@ -250,10 +231,9 @@ impl<'a> Refiner<'a> {
             ..
         } = *p;
         let [a, b, c, d] = verts.map(|v| self.dom.point(v));
-        let bad = |class, badness| {
+        let bad = |class| {
             Some(Bad {
                 class,
-                badness,
                 tet: t,
                 verts,
             })
@@ -262,7 +242,7 @@ impl<'a> Refiner<'a> {
         if near {
             let xi = longest_edge(a, b, c, d) / (EDGE_PER_RADIUS * f);
             if xi > self.params.size_factor {
-                return bad(SIZE, xi);
+                return bad(SIZE);
             }
         }
         // The measures, each computed only when the tests before it pass, sharing the edge
@@ -276,7 +256,7 @@ impl<'a> Refiner<'a> {
             None => {
                 let det = orient3d(a, b, c, d);
                 let Some(offset) = circum_offset_crossed([vw, wu, uv], lu, det) else {
-                    return bad(SLIVER, f64::INFINITY);
+                    return bad(SLIVER);
                 };
                 (offset, det)
             }
@@ -285,7 +265,7 @@ impl<'a> Refiner<'a> {
         if !near {
             let xi = circumradius / f;
             if xi > self.params.size_factor {
-                return bad(SIZE, xi);
+                return bad(SIZE);
             }
         }
         let e = [
@@ -299,7 +279,7 @@ impl<'a> Refiner<'a> {
         let l2 = e[0].min(e[1]).min(e[2]).min(e[3]).min(e[4]).min(e[5]);
         let rho = circumradius / l2.sqrt();
         if rho > self.params.rho0 {
-            return bad(RATIO, rho);
+            return bad(RATIO);
         }
         let n = [
             (d - b).cross(c - b).length_squared(),
@@ -312,7 +292,7 @@ impl<'a> Refiner<'a> {
         }
         let (sigma, max_cos_dihedral) = sliver_measures(a, b, c, d, l2);
         if self.picker.slivers.is_sliver(sigma, max_cos_dihedral) {
-            bad(SLIVER, max_cos_dihedral)
+            bad(SLIVER)
         } else {
             None
         }

@@ -52,10 +52,20 @@ pub fn measure(
             r.max_size_ratio = r.max_size_ratio.max(radius / f);
         }
     }
-    let edges = unique_edges(&mesh.tets, mesh.vertices.len());
-    let mut ratios = Vec::with_capacity(edges.len());
+    let (start, ends) = unique_edges(&mesh.tets, mesh.vertices.len());
+    let mut ratios = Vec::with_capacity(ends.len());
+    let mut chunk = Vec::with_capacity(SPACING_BATCH);
     let mut mids = Vec::with_capacity(SPACING_BATCH);
-    for chunk in edges.chunks(SPACING_BATCH) {
+    let mut edges = (0..mesh.vertices.len())
+        .flat_map(|a| {
+            ends[start[a]..start[a + 1]]
+                .iter()
+                .map(move |&b| (a as u32, b))
+        })
+        .peekable();
+    while edges.peek().is_some() {
+        chunk.clear();
+        chunk.extend(edges.by_ref().take(SPACING_BATCH));
         mids.clear();
         mids.extend(chunk.iter().map(|&(a, b)| (p(a) + p(b)) * 0.5));
         checked_batch(spacing, &mids, &mut f)?;
@@ -75,10 +85,12 @@ pub fn measure(
     Ok((r, bad_elsewhere))
 }
 
-/// Every edge of `tets` once, as (smaller, larger) vertex id, in lexicographic order: a counting
-/// sort by the smaller id, then each vertex's few larger neighbours sorted (a third of the
-/// instructions of sorting all six edges of every tet).
-fn unique_edges(tets: &[[u32; 4]], n_vertices: usize) -> Vec<(u32, u32)> {
+/// Every edge of `tets` once, as lists of larger vertex ids per smaller one: the edges of
+/// vertex `a` are `(a, ends[k])` for `k` in `start[a]..start[a + 1]`, in lexicographic order. A
+/// counting sort by the smaller id, then each vertex's few larger neighbours sorted and
+/// deduplicated in place (a third of the instructions of sorting all six edges of every tet, and
+/// no second list of the edges).
+fn unique_edges(tets: &[[u32; 4]], n_vertices: usize) -> (Vec<usize>, Vec<u32>) {
     const PAIRS: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
     let ends = |t: &[u32; 4], (i, j): (usize, usize)| (t[i].min(t[j]), t[i].max(t[j]));
     let mut start = vec![0usize; n_vertices + 1];
@@ -90,28 +102,38 @@ fn unique_edges(tets: &[[u32; 4]], n_vertices: usize) -> Vec<(u32, u32)> {
     for v in 0..n_vertices {
         start[v + 1] += start[v];
     }
-    let mut next = start.clone();
     let mut larger = vec![0u32; start[n_vertices]];
-    for t in tets {
-        for pair in PAIRS {
-            let (a, b) = ends(t, pair);
-            larger[next[a as usize]] = b;
-            next[a as usize] += 1;
+    {
+        // start[a] is advanced past each id written; start[a] ends where a + 1's list begins.
+        for t in tets {
+            for pair in PAIRS {
+                let (a, b) = ends(t, pair);
+                larger[start[a as usize]] = b;
+                start[a as usize] += 1;
+            }
         }
+        start.rotate_right(1);
+        start[0] = 0;
     }
-    let mut edges = Vec::with_capacity(larger.len() / 4);
+    // Compact: each list sorted and deduplicated, moved down to follow the previous one.
+    let mut kept = 0;
     for a in 0..n_vertices {
-        let list = &mut larger[start[a]..start[a + 1]];
-        list.sort_unstable();
+        let (from, to) = (start[a], start[a + 1]);
+        larger[from..to].sort_unstable();
+        start[a] = kept;
         let mut last = None;
-        for &b in list.iter() {
+        for k in from..to {
+            let b = larger[k];
             if last != Some(b) {
-                edges.push((a as u32, b));
+                larger[kept] = b;
+                kept += 1;
                 last = Some(b);
             }
         }
     }
-    edges
+    start[n_vertices] = kept;
+    larger.truncate(kept);
+    (start, larger)
 }
 
 /// The spacing at `points` into `out`, in one `at_many` call; the first value that is not
@@ -133,5 +155,38 @@ fn checked_batch(
     {
         Some((&point, &value)) => Err(MeshError::BadSpacing { point, value }),
         None => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::unique_edges;
+
+    #[test]
+    fn unique_edges_lists_each_edge_once_in_order() {
+        // Two tets sharing face (1, 2, 3), vertex 5 unused: 9 edges.
+        let tets = [[0, 1, 2, 3], [3, 2, 1, 4]];
+        let (start, ends) = unique_edges(&tets, 6);
+        let edges: Vec<(u32, u32)> = (0..6)
+            .flat_map(|a| {
+                ends[start[a]..start[a + 1]]
+                    .iter()
+                    .map(move |&b| (a as u32, b))
+            })
+            .collect();
+        let expected = [
+            (0, 1),
+            (0, 2),
+            (0, 3),
+            (1, 2),
+            (1, 3),
+            (1, 4),
+            (2, 3),
+            (2, 4),
+            (3, 4),
+        ];
+        assert_eq!(edges, expected);
+        assert_eq!(start.len(), 7);
+        assert_eq!(start[6], ends.len());
     }
 }

@@ -65,7 +65,6 @@ fn encroached_element_gone_after_resettling_is_not_split() {
     let (mut dom, regions, t) = cube_with_unsettled_subsegment();
     let bad = Bad {
         class: RATIO,
-        badness: 10.0,
         tet: t,
         verts: dom.dt.tet(t),
     };
@@ -97,7 +96,6 @@ fn refusals_are_counted_and_cascades_remembered() {
     let rb = 0.5 * dom.point(seg.0).distance(dom.point(seg.1));
     let bad = Bad {
         class: RATIO,
-        badness: 10.0,
         tet: t,
         verts: dom.dt.tet(t),
     };
