@@ -595,8 +595,10 @@ impl<'a> SurfaceMesher<'a> {
         let mut boundary = self.boundary(faces, stop_reason);
         self.input_samples();
         boundary.input_samples = self.input_samples.take();
+        // The cell level's queues and maps are freed before the output is built.
+        let spacing = self.vol.take().and_then(|v| v.spacing);
         let mut volume = self.volume_mesh(&boundary)?;
-        volume.spacing = self.vol.take().and_then(|v| v.spacing);
+        volume.spacing = spacing;
         volume.seconds_surface = seconds_surface;
         volume.seconds_volume = start.elapsed().as_secs_f64() - seconds_surface;
         Ok((boundary, volume))
@@ -1188,7 +1190,8 @@ pub struct VolumeMesh {
 impl SurfaceMesher<'_> {
     /// The inside tets, renumbered after `boundary` (built from the same triangulation).
     fn volume_mesh(&self, boundary: &Boundary) -> Result<VolumeMesh, MeshError> {
-        let mut id: FxHashMap<u32, u32> = FxHashMap::default();
+        const NEW: u32 = u32::MAX;
+        let mut id = vec![NEW; self.dt.num_vertex_ids()];
         let mut vertices = boundary.points.clone();
         // The boundary's numbering: its points are the triangulation's in first-seen order,
         // matched back by position (they are distinct vertices).
@@ -1198,7 +1201,13 @@ impl SurfaceMesher<'_> {
             .enumerate()
             .map(|(i, p)| (p.to_array().map(f64::to_bits), i as u32))
             .collect();
-        let (mut tets, mut regions) = (vec![], vec![]);
+        // Counted first so that the output is allocated once (it is the run's peak).
+        let inside = self
+            .dt
+            .finite_tet_ids()
+            .filter(|&t| self.region_of(t) != 0)
+            .count();
+        let (mut tets, mut regions) = (Vec::with_capacity(inside), Vec::with_capacity(inside));
         for t in self.dt.finite_tet_ids() {
             let region = self.region_of(t);
             if region == 0 {
@@ -1212,16 +1221,17 @@ impl SurfaceMesher<'_> {
                 ));
             }
             tets.push(tv.map(|v| {
-                *id.entry(v).or_insert_with(|| {
+                if id[v as usize] == NEW {
                     let p = self.dt.point(v);
-                    by_point
+                    id[v as usize] = by_point
                         .get(&p.to_array().map(f64::to_bits))
                         .copied()
                         .unwrap_or_else(|| {
                             vertices.push(p);
                             (vertices.len() - 1) as u32
-                        })
-                })
+                        });
+                }
+                id[v as usize]
             }));
         }
         Ok(VolumeMesh {
