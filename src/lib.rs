@@ -17,6 +17,7 @@ pub mod geom;
 pub mod improve;
 pub mod io;
 pub mod mesh;
+pub mod parallel;
 pub mod pipeline;
 pub mod plc;
 pub mod quadratic;

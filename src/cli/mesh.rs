@@ -4,6 +4,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use slivermesh::geom::TetQuality;
 use slivermesh::io::{self, ReadOptions};
 use slivermesh::mesh::{QuadraticNodes, TetMesh};
+use slivermesh::parallel::SplitSpacing;
 use slivermesh::pipeline;
 use slivermesh::plc::{Facet, PlcInput, Region};
 use slivermesh::refine::{
@@ -99,6 +100,11 @@ pub struct MeshOptions {
     /// that curving would fold keeps straight edges). Node order per format: docs/formats.md.
     #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=2))]
     pub order: u8,
+    /// Threads of the run's parallel steps (measuring every tet for the report and the quality
+    /// table, the final validity check, big batches of spacing values); refinement and
+    /// improvement run on one. The mesh is the same for every count (default 0: all cores).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
 }
 
 /// `--surface`: how the input facets bound the domain (`refine::SurfaceMode`).
@@ -167,6 +173,9 @@ impl MeshOptions {
         if let Some(v) = self.small_angle_reach {
             p.small_angle_reach = v;
         }
+        if let Some(v) = self.threads {
+            p.threads = v;
+        }
         p.region_sizes = self.region_size.clone();
         p.marker_sizes = self.marker_size.clone();
         p
@@ -203,6 +212,21 @@ pub fn run_mesh(
 ) -> Result<(), String> {
     let params = opts.params(input);
     params.check()?;
+    // One pool of `--threads` threads for the whole run (`pipeline::mesh` enters the same one),
+    // the quality measures of the output and its writing included.
+    slivermesh::parallel::with_threads(params.threads, || {
+        run_mesh_with(input, output, stats_json, quality_svg, opts, &params)
+    })
+}
+
+fn run_mesh_with(
+    input: &Path,
+    output: Option<&Path>,
+    stats_json: Option<&Path>,
+    quality_svg: Option<&Path>,
+    opts: &MeshOptions,
+    params: &Params,
+) -> Result<(), String> {
     if params.surface_mode == SurfaceMode::Keep
         && (opts.feature_angle.is_some() || opts.surface_distance.is_some())
     {
@@ -219,7 +243,11 @@ pub fn run_mesh(
         Some(p) => Some(io::sizefield::read_size_field(p)?),
         None => None,
     };
-    let spacing = match (&constant, &field) {
+    // The size field may be evaluated on several threads at once (each value is a point
+    // location in the background mesh): its big batches are split across them. A constant
+    // costs less than the split.
+    let split_field = field.as_ref().map(|f| SplitSpacing(f));
+    let spacing = match (&constant, &split_field) {
         (Some(c), _) => Some(c as &dyn Spacing),
         (None, Some(f)) => Some(f as &dyn Spacing),
         (None, None) => None,
@@ -236,7 +264,7 @@ pub fn run_mesh(
             ));
         }
         let existing = io::read_mesh(input).map_err(|e| e.to_string())?;
-        pipeline::remove_slivers(&existing, &params).map_err(|e| e.to_string())?
+        pipeline::remove_slivers(&existing, params).map_err(|e| e.to_string())?
     } else {
         let merge = !opts.no_merge && io::is_surface_file(input);
         let plc = io::read_plc(
@@ -246,7 +274,7 @@ pub fn run_mesh(
             },
         )
         .map_err(|e| e.to_string())?;
-        mesh_with_progress(&plc, &params, spacing)?
+        mesh_with_progress(&plc, params, spacing)?
     };
     let written = Written {
         mesh: &mesh,
@@ -576,6 +604,7 @@ mod tests {
             ("feature-angle", "feature_angle"),
             ("seed", "seed"),
             ("max-vertices", "max_vertices"),
+            ("threads", "threads"),
         ] {
             let spec = slivermesh::api::param_table::spec(name).unwrap();
             assert_eq!(stated(long), spec.default, "--{long} vs {name}");

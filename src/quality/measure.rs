@@ -109,11 +109,10 @@ pub fn measure(mesh: &TetMesh) -> Result<MeshQuality, QualityError> {
 pub fn per_tet(mesh: &TetMesh) -> Result<Vec<TetQuality>, QualityError> {
     check(mesh)?;
     let p = |v: u32| mesh.vertices[v as usize];
-    Ok(mesh
-        .tets
-        .iter()
-        .map(|t| TetQuality::of(p(t[0]), p(t[1]), p(t[2]), p(t[3])))
-        .collect())
+    // On the run's threads (`crate::parallel`), in tet order.
+    Ok(crate::parallel::map_collect(&mesh.tets, |t| {
+        TetQuality::of(p(t[0]), p(t[1]), p(t[2]), p(t[3]))
+    }))
 }
 
 /// [`measure`] from the tets' measures [`per_tet`] took (measured again if they are not as
@@ -167,11 +166,15 @@ pub fn measure_with(mesh: &TetMesh, per_tet: &[TetQuality]) -> Result<MeshQualit
         worst_tet: 0,
         min_dihedral_histogram: [0; MIN_BINS],
     };
-    for (i, t) in mesh.tets.iter().enumerate() {
-        t.iter().for_each(|&v| used[v as usize] = true);
+    // The sign decides validity, so it comes from the exact predicate itself; it and the
+    // longest edge are taken on the run's threads (`crate::parallel`, in tet order), the sums
+    // below in tet order as before.
+    let exact = crate::parallel::map_collect(&mesh.tets, |t| {
         let [a, b, c, d] = t.map(p);
-        // The sign decides validity, so it comes from the exact predicate itself.
-        let det = geom::orient3d(a, b, c, d);
+        (geom::orient3d(a, b, c, d), geom::longest_edge(a, b, c, d))
+    });
+    for (i, (t, &(det, longest))) in mesh.tets.iter().zip(&exact).enumerate() {
+        t.iter().for_each(|&v| used[v as usize] = true);
         if det < 0.0 {
             q.n_inverted += 1;
         } else if det == 0.0 {
@@ -180,7 +183,7 @@ pub fn measure_with(mesh: &TetMesh, per_tet: &[TetQuality]) -> Result<MeshQualit
         let m = per_tet[i];
         q.volume += m.volume;
         q.shortest_edge = q.shortest_edge.min(m.shortest_edge);
-        q.longest_edge = q.longest_edge.max(geom::longest_edge(a, b, c, d));
+        q.longest_edge = q.longest_edge.max(longest);
         if m.min_dihedral < q.min_dihedral_deg {
             q.min_dihedral_deg = m.min_dihedral;
             q.worst_tet = i;
