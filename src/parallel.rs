@@ -64,10 +64,13 @@ pub fn install<R: Send>(f: impl FnOnce() -> R + Send) -> R {
     }
 }
 
-/// Threads the parallel steps of the current run use (1 outside a run when rayon's global pool
-/// has one).
+/// Threads the parallel steps of the current run use (outside a run, or on one of the pool's
+/// own threads: rayon's current pool's). With one, the helpers below work on the calling
+/// thread, as serial code.
 pub fn current_threads() -> usize {
-    install(rayon::current_num_threads)
+    RUN_POOL
+        .with(|p| p.borrow().as_ref().map(|pool| pool.current_num_threads()))
+        .unwrap_or_else(rayon::current_num_threads)
 }
 
 /// Below this many items a slice is mapped on the calling thread: splitting it would cost more
@@ -77,7 +80,7 @@ const MIN_PARALLEL: usize = 2048;
 /// `items.iter().map(f).collect()`, on the run's threads when `items` is long: the same vector
 /// for every thread count.
 pub fn map_collect<T: Sync, U: Send>(items: &[T], f: impl Fn(&T) -> U + Sync + Send) -> Vec<U> {
-    if items.len() < MIN_PARALLEL {
+    if items.len() < MIN_PARALLEL || current_threads() <= 1 {
         return items.iter().map(f).collect();
     }
     install(|| items.par_iter().with_min_len(512).map(f).collect())
@@ -89,7 +92,7 @@ pub fn position_first<T: Sync>(
     items: &[T],
     pred: impl Fn(&T) -> bool + Sync + Send,
 ) -> Option<usize> {
-    if items.len() < MIN_PARALLEL {
+    if items.len() < MIN_PARALLEL || current_threads() <= 1 {
         return items.iter().position(pred);
     }
     install(|| items.par_iter().with_min_len(512).position_first(pred))
@@ -100,8 +103,9 @@ const MIN_SPACING_SPLIT: usize = 256;
 
 /// A spacing that may be evaluated on several threads at once (a `Sync` Rust type, or a C
 /// callback its caller declared thread-safe): its batches of at least 2 x 256 points are split
-/// across the run's threads, each part one `at_many` call of the inner spacing. Each point's
-/// value is the inner spacing's at that point, so the split changes no value.
+/// across the run's threads, each part one `at_many` call of the inner spacing (with one thread
+/// the whole batch is one call on the calling thread). Each point's value is the inner
+/// spacing's at that point, so the split changes no value.
 pub struct SplitSpacing<'a>(pub &'a (dyn Spacing + Sync));
 
 impl Spacing for SplitSpacing<'_> {
@@ -112,16 +116,13 @@ impl Spacing for SplitSpacing<'_> {
     fn at_many(&self, points: &[DVec3], out: &mut [f64]) {
         let n = points.len().min(out.len());
         let (points, out) = (&points[..n], &mut out[..n]);
-        if n < 2 * MIN_SPACING_SPLIT {
+        let threads = current_threads();
+        if n < 2 * MIN_SPACING_SPLIT || threads <= 1 {
             return self.0.at_many(points, out);
         }
         let inner = self.0;
+        let chunk = n.div_ceil(threads).max(MIN_SPACING_SPLIT);
         install(|| {
-            let threads = rayon::current_num_threads();
-            if threads <= 1 {
-                return inner.at_many(points, out);
-            }
-            let chunk = n.div_ceil(threads).max(MIN_SPACING_SPLIT);
             points
                 .par_chunks(chunk)
                 .zip(out.par_chunks_mut(chunk))
