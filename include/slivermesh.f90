@@ -14,6 +14,13 @@
 !>  - Outputs are copied into arrays you allocate after asking for the count (sm_num_*).
 !>  - Callbacks are bind(C) procedures passed with c_funloc(); user data with c_loc() or
 !>    c_null_ptr. See examples/fortran/cube.f90.
+!>  - Threads: sm_set_param(m, "threads", n) sets the threads of a run's parallel steps (0, the
+!>    default: all cores; the mesh is the same for every count). The spacing callback is called
+!>    only from the thread calling sm_refine, one call at a time, unless you declare it
+!>    thread-safe with sm_set_param(m, "spacing_thread_safe", 1d0): then big batches are split
+!>    across the run's threads and it is called from several at once (it must not write to
+!>    shared variables without synchronisation, nor use SAVE'd state, nor OpenMP threadprivate
+!>    data set only on your thread).
 !>  - Functions taking a string (sm_set_param, sm_get_param, sm_write, sm_write_binary) have
 !>    Fortran wrappers that add the terminating NUL; the raw bind(C) ones are *_c.
 module slivermesh
@@ -58,13 +65,15 @@ module slivermesh
   !> Shapes of the callbacks (declare yours like these, with bind(C), and pass c_funloc(f)).
   abstract interface
     !> Target element size at (x, y, z): finite and > 0, anything else fails sm_refine.
+    !> Called from one thread at a time unless "spacing_thread_safe" is 1 (see above).
     function sm_spacing_fn(x, y, z, user_data) bind(C) result(h)
       import :: c_double, c_ptr
       real(c_double), value :: x, y, z
       type(c_ptr), value :: user_data
       real(c_double) :: h
     end function sm_spacing_fn
-    !> Batched: out(i) = size at xyz(:, i), i = 1..n.
+    !> Batched: out(i) = size at xyz(:, i), i = 1..n. With "spacing_thread_safe" 1, several
+    !> calls (parts of one batch) may run at the same time on the run's threads.
     subroutine sm_spacing_batch_fn(n, xyz, out, user_data) bind(C)
       import :: c_double, c_ptr, c_size_t
       integer(c_size_t), value :: n
@@ -424,8 +433,8 @@ contains
     end do
   end function f_string
 
-  !> sm_set_param with a Fortran string name ("rho0", "sigma0", "seed", "surface_mode", ...;
-  !> every name and range: sm_set_param in slivermesh.h).
+  !> sm_set_param with a Fortran string name ("rho0", "sigma0", "seed", "surface_mode",
+  !> "threads", "spacing_thread_safe", ...; every name and range: sm_set_param in slivermesh.h).
   function sm_set_param(m, name, value) result(s)
     type(c_ptr), intent(in) :: m
     character(len=*), intent(in) :: name

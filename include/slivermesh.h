@@ -78,7 +78,7 @@ typedef double (*sm_spacing_fn)(double x, double y, double z, void *user_data);
 /**
  * Batched spacing callback: writes the spacing at the `n` points `xyz[3*i..3*i+3]` into
  * `out[i]`. Entries left unwritten count as NaN (an error). `n` >= 1, at most 4,096 (see
- * `sm_set_spacing_batch_cb` for how the points are grouped).
+ * `sm_set_spacing_batch_cb` for how the points are grouped, and which threads call it).
  */
 typedef void (*sm_spacing_batch_fn)(size_t n, const double *xyz, double *out, void *user_data);
 
@@ -347,7 +347,13 @@ sm_status sm_add_region(sm_mesher *m,
  * generalized winding number is at least 1/2; 0, the default, refuses it with the error that
  * names the defect), "order" (1, the default: four-node tets; 2: ten-node tets as well, read
  * with `sm_num_nodes`, `sm_get_nodes` and `sm_get_tets10`; in approximate mode the boundary
- * edges' nodes lie on the input surface).
+ * edges' nodes lie on the input surface), "threads" (whole number >= 0, default 0 = all
+ * cores, at most 255 used: threads of the run's parallel steps; refinement and improvement
+ * run on the thread calling `sm_refine`; the mesh is the same for every count),
+ * "spacing_thread_safe" (0, the default: the spacing callback is called only from the thread
+ * calling `sm_refine`, one call at a time; 1: the caller declares that the callback, with its
+ * `user_data`, may be called from several threads at the same time, and big batches are then
+ * split across the run's threads).
  * An unknown name or out-of-range value gives `SM_ERR_INVALID_ARGUMENT`; `sm_last_error`
  * says why (and lists the valid names).
  *
@@ -379,6 +385,10 @@ sm_status sm_set_spacing_const(sm_mesher *m, double h);
  * constant or batched spacing. `f` == NULL removes it: spacing becomes automatic. `user_data` is
  * passed back untouched; it must stay valid while the handle may call `f` (during `sm_refine`).
  *
+ * Threads: `f` is called only from the thread that calls `sm_refine`, one call at a time,
+ * unless the parameter "spacing_thread_safe" is 1: then `f` may also be called from the run's
+ * other threads ("threads"), several calls at the same time, and must be safe for that.
+ *
  * # Safety
  * `m` is NULL or a live handle; `f` is NULL or a function with the `sm_spacing_fn` signature
  * that does not unwind (no C++ exception, no Fortran error stop escaping it).
@@ -398,6 +408,13 @@ sm_status sm_set_spacing_cb(sm_mesher *m, sm_spacing_fn f, void *user_data);
  * points: a tet looked at again after a boundary split, the approximate mode's feature-curve
  * sampling and subsegment lengths (each step depends on the previous value). The values are
  * the same as with `sm_set_spacing_cb` and the same function, and so is the mesh.
+ *
+ * Threads: as for `sm_set_spacing_cb`, `f` is called only from the thread that calls
+ * `sm_refine`, one call at a time, unless "spacing_thread_safe" is 1: then a batch of 512
+ * points or more (the first classification, the surface samples, the report's figures) is
+ * split into one part per thread of the run ("threads"), each part of at least 256 points one
+ * call, made at the same time from those threads. Every point gets the same value, and the
+ * mesh is the same, however the batches are split.
  *
  * # Safety
  * As `sm_set_spacing_cb`, with the `sm_spacing_batch_fn` signature.
@@ -492,6 +509,12 @@ sm_status sm_set_progress_cb(sm_mesher *m, sm_progress_fn f, void *user_data);
  * no mesh and `sm_last_error` says why: `SM_ERR_INVALID_INPUT` (the domain, naming the facet or
  * vertex), `SM_ERR_SPACING` (a spacing value that is not finite and positive, naming the point),
  * `SM_ERR_CANCELLED` (the progress callback), `SM_ERR_INTERNAL`.
+ *
+ * Threads: the parallel steps of the run (measuring the tets, the final validity check, the
+ * batches of a spacing callback declared thread-safe) use the "threads" parameter's count
+ * (0, the default: all cores); refinement and improvement run on the calling thread, and so
+ * do the progress callback and a spacing callback not declared thread-safe
+ * ("spacing_thread_safe" 0, the default). The mesh is the same for every thread count.
  *
  * # Safety
  * `m` is NULL or a live handle; registered callbacks and their `user_data` are valid.

@@ -37,6 +37,8 @@ pub mod io;
 #[doc(hidden)]
 pub mod mesh;
 #[doc(hidden)]
+pub mod parallel;
+#[doc(hidden)]
 pub mod pipeline;
 #[doc(hidden)]
 pub mod plc;

@@ -17,7 +17,23 @@ use crate::run::spacing::Spacing;
 /// automatic. With `params.order` 2, the mid-edge nodes of ten-node tets come along
 /// (`crate::quadratic`): on the input surface in approximate mode, at the midpoints in keep
 /// mode, whose facets are planar.
+///
+/// The run's parallel steps use `params.threads` threads (`crate::parallel::with_threads`);
+/// everything else, `spacing` and `progress` included, runs on the calling thread. A spacing
+/// that may be evaluated on several threads at once comes wrapped in
+/// `crate::parallel::SplitSpacing`.
 pub fn mesh(
+    input: &PlcInput,
+    params: &Params,
+    spacing: Option<&dyn Spacing>,
+    progress: Option<Progress>,
+) -> Result<(TetMesh, Option<QuadraticNodes>, Report), MeshError> {
+    crate::parallel::with_threads(params.threads, || {
+        mesh_here(input, params, spacing, progress)
+    })
+}
+
+fn mesh_here(
     input: &PlcInput,
     params: &Params,
     spacing: Option<&dyn Spacing>,
@@ -50,8 +66,16 @@ pub fn mesh(
 /// Removes the slivers of an existing mesh (`refine::existing`), keeping its boundary and
 /// interface triangles, holes and regions, then improves it with that boundary fixed (there is
 /// no facet description to slide on). With `params.order` 2, the mid-edge nodes at the
-/// midpoints. Keep mode only: an existing mesh's boundary is kept as it is.
+/// midpoints. Keep mode only: an existing mesh's boundary is kept as it is. On
+/// `params.threads` threads, as [`mesh`].
 pub fn remove_slivers(
+    existing: &TetMesh,
+    params: &Params,
+) -> Result<(TetMesh, Option<QuadraticNodes>, Report), MeshError> {
+    crate::parallel::with_threads(params.threads, || remove_slivers_here(existing, params))
+}
+
+fn remove_slivers_here(
     existing: &TetMesh,
     params: &Params,
 ) -> Result<(TetMesh, Option<QuadraticNodes>, Report), MeshError> {

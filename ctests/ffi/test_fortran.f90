@@ -73,6 +73,11 @@ program test_fortran
   call expect(sm_set_param(m, 'rho00', 1.5d0) == SM_ERR_INVALID_ARGUMENT, 'unknown name')
   call expect(index(sm_last_error(m), 'valid names') > 0, 'unknown name message')
   call expect(sm_set_param(m, 'sigma0', 1d0) == SM_ERR_INVALID_ARGUMENT, 'sigma0 range')
+  call expect(sm_get_param(m, 'threads', v) == SM_OK .and. v == 0d0, 'threads default')
+  call expect(sm_set_param(m, 'threads', 2d0) == SM_OK, 'set threads')
+  call expect(sm_set_param(m, 'threads', -1d0) == SM_ERR_INVALID_ARGUMENT, 'threads range')
+  call expect(sm_set_param(m, 'spacing_thread_safe', 1d0) == SM_OK, 'set spacing_thread_safe')
+  call expect(sm_set_param(m, 'spacing_thread_safe', 0d0) == SM_OK, 'reset spacing_thread_safe')
   ! A size field whose one tet names a vertex that is not there.
   call expect(sm_set_spacing_mesh(m, [0d0, 0d0, 0d0, 1d0, 0d0, 0d0, 0d0, 1d0, 0d0, 0d0, 0d0, 1d0], &
                                   4_c_size_t, [0, 1, 2, 4], 1_c_size_t, [0.1d0, 0.1d0, 0.1d0, 0.1d0]) &

@@ -7,6 +7,7 @@ use super::params::{get_param, set_param, Params};
 use super::spacing::{valid_value, Checked, SpacingChoice};
 use crate::geom::MAX_COORD;
 use crate::mesh::TetMesh;
+use crate::parallel::SplitSpacing;
 use crate::plc::{Facet, PlcInput, Region};
 use crate::run::error::MeshError;
 use crate::run::progress::Progress;
@@ -247,6 +248,15 @@ impl Mesher {
         self.changed()
     }
 
+    /// A spacing that may be evaluated from several threads at once: like [`Self::set_spacing`],
+    /// but its batches of 512 points or more (the first classification, the report's
+    /// figures) are split across the run's threads (parameter `threads`). The values, and the
+    /// mesh, are the same.
+    pub fn set_spacing_sync<S: Spacing + Send + Sync + 'static>(&mut self, s: S) -> &mut Self {
+        self.spacing = SpacingChoice::Shared(Box::new(s));
+        self.changed()
+    }
+
     /// Limits the spacing in the region of attribute `id` to at most `h` (finite, > 0): its tets
     /// get the smaller of `h` and the spacing there (CLI `--region-size ID:H`). Given again
     /// for the same id, the new `h` replaces the old. An id the input has no region of fails
@@ -369,7 +379,7 @@ impl Mesher {
         mut progress: Option<Progress>,
     ) -> Result<&Report, Error> {
         self.output = None;
-        let constant;
+        let (constant, split);
         let chosen: Option<&dyn Spacing> = match (spacing, &self.spacing) {
             (Some(s), _) => Some(s),
             (None, SpacingChoice::Automatic) => None,
@@ -378,6 +388,10 @@ impl Mesher {
                 Some(&constant)
             }
             (None, SpacingChoice::Custom(s)) => Some(s.as_ref()),
+            (None, SpacingChoice::Shared(s)) => {
+                split = SplitSpacing(s.as_ref());
+                Some(&split)
+            }
         };
         let checked = chosen.map(Checked::new);
         let stored = &mut self.progress;

@@ -236,6 +236,22 @@ pub const PARAMS: &[ParamSpec] = &[
         range: Range::Choice(&[1.0, 2.0]),
         doc: "1: four-node tets; 2: ten-node tets, boundary nodes on the input surface.",
     },
+    ParamSpec {
+        name: "threads",
+        aliases: &[],
+        default: 0.0,
+        range: Range::Whole { min: 0 },
+        doc: "Threads of the run's parallel steps (0: all cores; at most 255 used); the mesh is \
+              the same for every count (docs/parallel.md).",
+    },
+    ParamSpec {
+        name: "spacing_thread_safe",
+        aliases: &[],
+        default: 0.0,
+        range: FLAG,
+        doc: "C ABI, 1: the spacing callback may be called from several threads at once; 0: \
+              from one thread at a time (the one that called `sm_refine`).",
+    },
 ];
 
 /// The parameter called `name` (or one of its aliases).

@@ -27,6 +27,8 @@ pub const PARAM_NAMES: &[&str] = &[
     "improve_target",
     "repair",
     "order",
+    "threads",
+    "spacing_thread_safe",
 ];
 
 /// Smallest accepted `rho0` (the refiner's own limit, `Params::check`).
@@ -53,8 +55,10 @@ const MAX_EXACT_INT: f64 = 9_007_199_254_740_992.0; // 2^53
 /// with a smaller dihedral angle; 0 = the mode's default, 26 keep / 20 approximate), `repair`
 /// (0 or 1: approximate mode meshes a dirty surface, open, self-intersecting or overlapping,
 /// as the solid where its winding number is at least 1/2), `order` (1: four-node tets, 2:
-/// ten-node tets with boundary nodes on the input surface). Integer and 0/1 parameters must be
-/// given as whole numbers.
+/// ten-node tets with boundary nodes on the input surface), `threads` (integer >= 0: threads of
+/// the run's parallel steps, 0 = all cores, at most 255 used; the mesh is the same for every
+/// count), `spacing_thread_safe` (0 or 1: 1 declares that a C spacing callback may be called
+/// from several threads at once). Integer and 0/1 parameters must be given as whole numbers.
 /// The result also passes `Params::check` (the refiner's own validation), so a value accepted
 /// here is never refused by `refine`.
 pub fn set_param(params: &mut Params, name: &str, value: f64) -> Result<(), Error> {
@@ -210,6 +214,19 @@ fn set_unchecked(params: &mut Params, name: &str, value: f64) -> Result<(), Erro
                 }
             }
         }
+        "threads" => params.threads = whole(name, value, 0.0)? as usize,
+        "spacing_thread_safe" => {
+            params.spacing_thread_safe = match value {
+                0.0 => false,
+                1.0 => true,
+                _ => {
+                    return invalid(format!(
+                        "spacing_thread_safe = {value}: must be 1 (the C spacing callback may be \
+                         called from several threads at once) or 0 (one thread at a time)"
+                    ))
+                }
+            }
+        }
         "refine" => {
             params.refine = match value {
                 0.0 => false,
@@ -256,6 +273,8 @@ pub fn get_param(params: &Params, name: &str) -> Result<f64, Error> {
         "improve_target" => params.improve_target,
         "repair" => f64::from(u8::from(params.repair)),
         "order" => f64::from(params.order),
+        "threads" => params.threads as f64,
+        "spacing_thread_safe" => f64::from(u8::from(params.spacing_thread_safe)),
         _ => {
             return invalid(format!(
                 "unknown parameter \"{name}\"; valid names: {}",
@@ -330,6 +349,8 @@ mod tests {
             ("improve_target", 30.0),
             ("repair", 1.0),
             ("order", 2.0),
+            ("threads", 3.0),
+            ("spacing_thread_safe", 1.0),
         ];
         assert_eq!(values.len(), PARAM_NAMES.len());
         for (name, v) in values {
@@ -346,6 +367,11 @@ mod tests {
         assert!(set_param(&mut p, "repair", 2.0).is_err());
         assert!(set_param(&mut p, "order", 3.0).is_err());
         assert!(set_param(&mut p, "order", 1.5).is_err());
+        assert_eq!(p.threads, 3);
+        assert!(p.spacing_thread_safe);
+        assert!(set_param(&mut p, "threads", -1.0).is_err());
+        assert!(set_param(&mut p, "threads", 1.5).is_err());
+        assert!(set_param(&mut p, "spacing_thread_safe", 2.0).is_err());
     }
 
     #[test]

@@ -16,6 +16,9 @@ pub enum SpacingChoice {
     Constant(f64),
     /// A user function (a Rust closure or any [`Spacing`] implementation).
     Custom(Box<dyn Spacing + Send>),
+    /// A user function that may be evaluated from several threads at once (`Sync`): big
+    /// batches are split across the run's threads (`crate::parallel::SplitSpacing`).
+    Shared(Box<dyn Spacing + Send + Sync>),
 }
 
 impl std::fmt::Debug for SpacingChoice {
@@ -24,6 +27,7 @@ impl std::fmt::Debug for SpacingChoice {
             SpacingChoice::Automatic => write!(f, "Automatic"),
             SpacingChoice::Constant(h) => write!(f, "Constant({h})"),
             SpacingChoice::Custom(_) => write!(f, "Custom(..)"),
+            SpacingChoice::Shared(_) => write!(f, "Shared(..)"),
         }
     }
 }

@@ -355,3 +355,42 @@ fn improve_target_defaults_by_surface_mode() {
     p.improve_target = 30.0;
     assert_eq!(p.effective_improve_target(), 30.0);
 }
+
+/// The mesh and report figures do not depend on the `threads` parameter, and a spacing given
+/// as `Sync` (its big batches split across the threads) gives the mesh of the same function
+/// given as a plain closure.
+#[test]
+fn threads_and_shared_spacing_give_the_same_mesh() {
+    let f = |p: DVec3| 0.06 + 0.1 * p.x;
+    let run = |threads: f64, shared: bool| {
+        let mut m = cube();
+        m.set_param("threads", threads).unwrap();
+        if shared {
+            m.set_spacing_sync(crate::run::spacing::FnSpacing(f));
+        } else {
+            m.set_spacing_fn(f);
+        }
+        let mut report = serde_json::to_value(m.refine().unwrap()).unwrap();
+        untimed(&mut report);
+        (m.take_output().unwrap().mesh, report)
+    };
+    let (mesh, report) = run(1.0, false);
+    assert!(mesh.tets.len() > 5000, "{} tets", mesh.tets.len());
+    for (threads, shared) in [(2.0, false), (1.0, true), (3.0, true), (0.0, true)] {
+        let (m, r) = run(threads, shared);
+        assert_eq!(m, mesh, "threads {threads}, shared {shared}");
+        assert_eq!(r, report, "threads {threads}, shared {shared}");
+    }
+}
+
+/// `report` (a report as JSON) without its timings.
+fn untimed(report: &mut serde_json::Value) {
+    match report {
+        serde_json::Value::Object(fields) => {
+            fields.retain(|k, _| !k.starts_with("seconds"));
+            fields.values_mut().for_each(untimed);
+        }
+        serde_json::Value::Array(items) => items.iter_mut().for_each(untimed),
+        _ => {}
+    }
+}

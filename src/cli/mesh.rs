@@ -98,6 +98,11 @@ pub struct MeshOptions {
     /// that curving would fold keeps straight edges). Node order per format: docs/formats.md.
     #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=2))]
     pub order: u8,
+    /// Threads of the run's parallel steps (measuring every tet for the report and the quality
+    /// table, the final validity check, big batches of spacing values); refinement and
+    /// improvement run on one. The mesh is the same for every count (default 0: all cores).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
 }
 
 /// `--surface`: how the input facets bound the domain (`run::params::SurfaceMode`).
@@ -166,6 +171,9 @@ impl MeshOptions {
         if let Some(v) = self.small_angle_reach {
             p.small_angle_reach = v;
         }
+        if let Some(v) = self.threads {
+            p.threads = v;
+        }
         p.region_sizes = self.region_size.clone();
         p.marker_sizes = self.marker_size.clone();
         p
@@ -202,6 +210,21 @@ pub fn run_mesh(
 ) -> Result<(), String> {
     let params = opts.params(input);
     params.check()?;
+    // One pool of `--threads` threads for the whole run (`pipeline::mesh` enters the same one),
+    // the quality measures of the output and its writing included.
+    slivermesh::parallel::with_threads(params.threads, || {
+        run_mesh_with(input, output, stats_json, quality_svg, opts, &params)
+    })
+}
+
+fn run_mesh_with(
+    input: &Path,
+    output: Option<&Path>,
+    stats_json: Option<&Path>,
+    quality_svg: Option<&Path>,
+    opts: &MeshOptions,
+    params: &Params,
+) -> Result<(), String> {
     if params.surface_mode == SurfaceMode::Keep
         && (opts.feature_angle.is_some() || opts.surface_distance.is_some())
     {
@@ -229,7 +252,7 @@ pub fn run_mesh(
             ));
         }
         let existing = io::read_mesh(input).map_err(|e| e.to_string())?;
-        let mut mesher = Mesher::new().with_params(params);
+        let mut mesher = Mesher::new().with_params(params.clone());
         mesher
             .set_existing_mesh(existing)
             .map_err(|e| e.to_string())?;
@@ -245,12 +268,14 @@ pub fn run_mesh(
         .map_err(|e| e.to_string())?;
         Mesher::from_plc(plc)
             .map_err(|e| e.to_string())?
-            .with_params(params)
+            .with_params(params.clone())
     };
     if let Some(h) = opts.size {
         mesher.set_spacing_constant(h).map_err(|e| e.to_string())?;
     } else if let Some(f) = field {
-        mesher.set_spacing(f);
+        // Each value is a point location in the background mesh: big batches of them are
+        // split across the run's threads.
+        mesher.set_spacing_sync(f);
     }
     let MeshOutput {
         mesh,
@@ -592,6 +617,7 @@ mod tests {
             ("feature-angle", "feature_angle"),
             ("seed", "seed"),
             ("max-vertices", "max_vertices"),
+            ("threads", "threads"),
         ] {
             let spec = slivermesh::api::param_table::spec(name).unwrap();
             assert_eq!(stated(long), spec.default, "--{long} vs {name}");

@@ -2,7 +2,11 @@
 //!
 //! The wrappers hold the caller's `user_data` pointer, so they are neither `Send` nor `Sync`:
 //! they live in the handle and are lent to `Mesher::refine_with` for one run on the calling
-//! thread, never stored in the (`Send`) `Mesher` itself.
+//! thread, never stored in the (`Send`) `Mesher` itself. Not being `Sync`, a spacing callback
+//! is only ever called from the thread that called `sm_refine` (the run's parallel steps,
+//! `crate::parallel`, cannot reach it), one call at a time; only a callback its caller declared
+//! thread-safe (parameter "spacing_thread_safe" = 1) is wrapped as [`ThreadSafeCSpacing`],
+//! which is `Sync`, and called from the run's threads at once.
 
 use crate::run::spacing::Spacing;
 use glam::DVec3;
@@ -17,7 +21,7 @@ pub type sm_spacing_fn =
 
 /// Batched spacing callback: writes the spacing at the `n` points `xyz[3*i..3*i+3]` into
 /// `out[i]`. Entries left unwritten count as NaN (an error). `n` >= 1, at most 4,096 (see
-/// `sm_set_spacing_batch_cb` for how the points are grouped).
+/// `sm_set_spacing_batch_cb` for how the points are grouped, and which threads call it).
 #[allow(non_camel_case_types)]
 pub type sm_spacing_batch_fn =
     Option<unsafe extern "C" fn(n: usize, xyz: *const f64, out: *mut f64, user_data: *mut c_void)>;
@@ -98,6 +102,28 @@ impl Spacing for CSpacing {
                 unsafe { f(n, xyz.as_ptr(), out.as_mut_ptr(), self.user_data) };
             }
         }
+    }
+}
+
+/// A C spacing callback whose caller declared it thread-safe (parameter
+/// "spacing_thread_safe" = 1): it may be called from several threads at once.
+#[derive(Clone, Copy)]
+pub(crate) struct ThreadSafeCSpacing(pub(crate) CSpacing);
+
+// SAFETY: the only state is the function pointer and `user_data`, which this crate never
+// dereferences; it only passes them to the callback. The caller declared through
+// "spacing_thread_safe" = 1 that the callback may be called with this `user_data` from several
+// threads at the same time, which is all that sharing a `&ThreadSafeCSpacing` between threads
+// allows. Without that declaration a `CSpacing` (not `Sync`) is used instead.
+unsafe impl Sync for ThreadSafeCSpacing {}
+
+impl Spacing for ThreadSafeCSpacing {
+    fn at(&self, p: DVec3) -> f64 {
+        self.0.at(p)
+    }
+
+    fn at_many(&self, points: &[DVec3], out: &mut [f64]) {
+        self.0.at_many(points, out)
     }
 }
 

@@ -31,7 +31,13 @@ use std::ffi::{c_char, c_void};
 /// generalized winding number is at least 1/2; 0, the default, refuses it with the error that
 /// names the defect), "order" (1, the default: four-node tets; 2: ten-node tets as well, read
 /// with `sm_num_nodes`, `sm_get_nodes` and `sm_get_tets10`; in approximate mode the boundary
-/// edges' nodes lie on the input surface).
+/// edges' nodes lie on the input surface), "threads" (whole number >= 0, default 0 = all
+/// cores, at most 255 used: threads of the run's parallel steps; refinement and improvement
+/// run on the thread calling `sm_refine`; the mesh is the same for every count),
+/// "spacing_thread_safe" (0, the default: the spacing callback is called only from the thread
+/// calling `sm_refine`, one call at a time; 1: the caller declares that the callback, with its
+/// `user_data`, may be called from several threads at the same time, and big batches are then
+/// split across the run's threads).
 /// An unknown name or out-of-range value gives `SM_ERR_INVALID_ARGUMENT`; `sm_last_error`
 /// says why (and lists the valid names).
 ///
@@ -99,6 +105,10 @@ pub unsafe extern "C" fn sm_set_spacing_const(m: *mut sm_mesher, h: f64) -> sm_s
 /// constant or batched spacing. `f` == NULL removes it: spacing becomes automatic. `user_data` is
 /// passed back untouched; it must stay valid while the handle may call `f` (during `sm_refine`).
 ///
+/// Threads: `f` is called only from the thread that calls `sm_refine`, one call at a time,
+/// unless the parameter "spacing_thread_safe" is 1: then `f` may also be called from the run's
+/// other threads ("threads"), several calls at the same time, and must be safe for that.
+///
 /// # Safety
 /// `m` is NULL or a live handle; `f` is NULL or a function with the `sm_spacing_fn` signature
 /// that does not unwind (no C++ exception, no Fortran error stop escaping it).
@@ -129,6 +139,13 @@ pub unsafe extern "C" fn sm_set_spacing_cb(
 /// points: a tet looked at again after a boundary split, the approximate mode's feature-curve
 /// sampling and subsegment lengths (each step depends on the previous value). The values are
 /// the same as with `sm_set_spacing_cb` and the same function, and so is the mesh.
+///
+/// Threads: as for `sm_set_spacing_cb`, `f` is called only from the thread that calls
+/// `sm_refine`, one call at a time, unless "spacing_thread_safe" is 1: then a batch of 512
+/// points or more (the first classification, the surface samples, the report's figures) is
+/// split into one part per thread of the run ("threads"), each part of at least 256 points one
+/// call, made at the same time from those threads. Every point gets the same value, and the
+/// mesh is the same, however the batches are split.
 ///
 /// # Safety
 /// As `sm_set_spacing_cb`, with the `sm_spacing_batch_fn` signature.

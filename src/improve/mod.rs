@@ -416,21 +416,23 @@ impl PassState {
 }
 
 /// Fails with [`MeshError::DegenerateTet`] naming the first tet (in output order) that is
-/// not positively oriented by the exact `orient3d`.
+/// not positively oriented by the exact `orient3d`. The tets are tested on the run's threads
+/// (`crate::parallel`).
 pub fn check_no_degenerate(mesh: &TetMesh) -> Result<(), MeshError> {
-    for (i, t) in mesh.tets.iter().enumerate() {
-        let p = t.map(|v| mesh.vertices[v as usize]);
-        let o = orient3d(p[0], p[1], p[2], p[3]);
-        if o <= 0.0 {
-            return Err(MeshError::DegenerateTet {
-                index: i,
-                vertices: *t,
-                points: Box::new(p),
-                inverted: o < 0.0,
-            });
-        }
+    let points = |t: &[u32; 4]| t.map(|v| mesh.vertices[v as usize]);
+    let orient = |t: &[u32; 4]| {
+        let p = points(t);
+        orient3d(p[0], p[1], p[2], p[3])
+    };
+    match crate::parallel::position_first(&mesh.tets, |t| orient(t) <= 0.0) {
+        None => Ok(()),
+        Some(i) => Err(MeshError::DegenerateTet {
+            index: i,
+            vertices: mesh.tets[i],
+            points: Box::new(points(&mesh.tets[i])),
+            inverted: orient(&mesh.tets[i]) < 0.0,
+        }),
     }
-    Ok(())
 }
 
 /// The step every mesher output goes through: improvement (or, with `params.improve` false,

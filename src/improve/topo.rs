@@ -124,8 +124,14 @@ impl Work {
         for (s, &d) in w.star.iter_mut().zip(&degree) {
             s.reserve_exact(d as usize + 4);
         }
-        for (i, &t) in mesh.tets.iter().enumerate() {
-            w.add_tet(t, mesh.tet_regions.get(i).copied().unwrap_or(0));
+        // The tets' objectives on the run's threads (`crate::parallel`, in tet order).
+        let pos = &w.pos;
+        let qs = crate::parallel::map_collect(&mesh.tets, |t| {
+            let [a, b, c, d] = t.map(|v| pos[v as usize]);
+            objective.of(a, b, c, d)
+        });
+        for (i, (&t, q)) in mesh.tets.iter().zip(qs).enumerate() {
+            w.push_tet(t, mesh.tet_regions.get(i).copied().unwrap_or(0), q);
         }
         w.bmap.reserve(mesh.boundary.len());
         for (i, &f) in mesh.boundary.iter().enumerate() {
@@ -220,6 +226,11 @@ impl Work {
     pub fn add_tet(&mut self, t: [u32; 4], region: i32) -> u32 {
         let [a, b, c, d] = self.points(&t);
         let q = self.objective.of(a, b, c, d);
+        self.push_tet(t, region, q)
+    }
+
+    /// [`Self::add_tet`] with its objective `q` already known.
+    fn push_tet(&mut self, t: [u32; 4], region: i32, q: f64) -> u32 {
         let id = match self.free.pop() {
             Some(id) => {
                 self.tets[id as usize] = t;

@@ -105,12 +105,13 @@ fn mesh_domain(
     let mut regions = dom.mark_domain(&plc, unseeded)?;
     regions.limit_sizes(&params.region_sizes)?;
     let seconds_recovery = start.elapsed().as_secs_f64();
-    let auto;
+    let (auto, split_auto);
     let spacing: &dyn Spacing = match spacing {
         Some(s) => s,
         None => {
             auto = spacing::AutoSpacing::from_boundary(&dom);
-            &auto
+            split_auto = crate::parallel::SplitSpacing(&auto);
+            &split_auto
         }
     };
     let capped;

@@ -66,6 +66,11 @@ pub struct Params {
     /// (the smaller of it and the spacing's value; `refine::MarkerCaps`). Each H finite and > 0; an
     /// ID no input facet has is an error. Not a parameter by name.
     pub marker_sizes: Vec<(i32, f64)>,
+    /// Threads of the run's parallel steps (`crate::parallel`; 0 = all cores): the output is
+    /// the same for every count. `spacing_thread_safe`: a C spacing callback may be called
+    /// from several of them at once (the C ABI's declaration; Rust spacings say it by `Sync`).
+    pub threads: usize,
+    pub spacing_thread_safe: bool,
 }
 
 /// Default improvement target (degrees) in keep mode: every acute-free model reaches 25.
@@ -112,6 +117,8 @@ impl Default for Params {
             order: 1,
             region_sizes: Vec::new(),
             marker_sizes: Vec::new(),
+            threads: 0,
+            spacing_thread_safe: false,
         }
     }
 }

@@ -59,18 +59,21 @@ impl Thickness {
                 }
             }
         }
-        let mut radius: Vec<f64> = surface
+        // Each vertex's balls on their own, on the run's threads (`crate::parallel`, in vertex
+        // order).
+        let vertices: Vec<(DVec3, DVec3, bool)> = surface
             .vertices
             .iter()
             .zip(&normals)
             .zip(&smooth)
-            .map(|((&p, &n), &smooth)| {
-                if !smooth {
-                    return cap;
-                }
-                shrink(oracle, p, -n, cap).min(shrink(oracle, p, n, cap))
-            })
+            .map(|((&p, &n), &smooth)| (p, n, smooth))
             .collect();
+        let mut radius = crate::parallel::map_collect(&vertices, |&(p, n, smooth)| {
+            if !smooth {
+                return cap;
+            }
+            shrink(oracle, p, -n, cap).min(shrink(oracle, p, n, cap))
+        });
         lipschitz(surface, &mut radius);
         Thickness { radius }
     }
