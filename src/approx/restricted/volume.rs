@@ -47,7 +47,17 @@ pub struct VolumeCriteria {
 
 /// A cell's circumcentre and the spacing there, as evaluated when it was classified (looked
 /// at again with the same centre, the cell reuses the value instead of a second evaluation).
-type Sized = Option<(DVec3, f64)>;
+/// The spacing a cell was classified with, reused while the cell (its id and vertices) is the
+/// same: its circumcentre is then the same point.
+type Sized = Option<f64>;
+
+/// A queued bad cell: id, vertices, and its [`Sized`] value (NaN for none; 32 bytes, as the
+/// queues hold up to about one entry per tet of the final mesh).
+type Queued = (u32, [u32; 4], f64);
+
+fn queued(t: u32, tv: [u32; 4], sized: Sized) -> Queued {
+    (t, tv, sized.unwrap_or(f64::NAN))
+}
 
 /// The most cells classified with one batched spacing evaluation (`Spacing::at_many`).
 const SPACING_BATCH: usize = crate::refine::SPACING_BATCH;
@@ -84,7 +94,7 @@ pub(super) struct VolumeState {
     /// Li's point choice (small slivers, random draws); None while lent out.
     picker: Option<Picker>,
     /// Bad cells: id, vertices, and the spacing at the circumcentre they were classified with.
-    queues: [VecDeque<(u32, [u32; 4], Sized)>; 3],
+    queues: [VecDeque<Queued>; 3],
     deferrals: FxHashMap<[u32; 4], u8>,
     pub(super) spacing: Option<AutoSpacing>,
     /// Per vertex id: within a small corner's ball (cells there are left as they are).
@@ -201,16 +211,16 @@ impl SurfaceMesher<'_> {
             for (&t, step) in chunk.iter().zip(&steps) {
                 let (class, sized) = match *step {
                     CellStep::Done(class) => (class, None),
-                    CellStep::Need { centre, r } => {
+                    CellStep::Need { r, .. } => {
                         let f = values[k];
                         k += 1;
-                        (self.finish_cell(t, r, f), Some((centre, f)))
+                        (self.finish_cell(t, r, f), Some(f))
                     }
                 };
                 if let Some(class) = class {
                     let tv = self.dt.tet(t);
                     if let Some(vol) = self.vol.as_mut() {
-                        vol.queues[class].push_back((t, tv, sized));
+                        vol.queues[class].push_back(queued(t, tv, sized));
                     }
                 }
             }
@@ -233,17 +243,14 @@ impl SurfaceMesher<'_> {
     }
 
     /// The class of a bad inside cell, or None when it is good, outside or next to a small
-    /// corner; `sized`: the centre and spacing it was classified with before, reused when the
-    /// centre is the same. Returns the centre and spacing used too.
+    /// corner; `sized`: the spacing this same cell was classified with before (the caller
+    /// checks that it is the same), reused. Returns the spacing used too.
     fn cell_class(&self, t: u32, sized: Sized) -> (Option<usize>, Sized) {
         match self.prepare_cell(t) {
             CellStep::Done(class) => (class, None),
             CellStep::Need { centre, r } => {
-                let f = match sized {
-                    Some((c, f)) if c == centre => f,
-                    _ => self.cell_spacing().at(centre),
-                };
-                (self.finish_cell(t, r, f), Some((centre, f)))
+                let f = sized.unwrap_or_else(|| self.cell_spacing().at(centre));
+                (self.finish_cell(t, r, f), Some(f))
             }
         }
     }
@@ -293,14 +300,14 @@ impl SurfaceMesher<'_> {
         vol.slivers.is_sliver(sigma, max_cos).then_some(SLIVER)
     }
 
-    /// The next bad cell still present, largest class first, with the centre and spacing it
-    /// was classified with.
+    /// The next bad cell still present, largest class first, with the spacing it was
+    /// classified with.
     fn next_cell(&mut self) -> Option<(u32, Sized)> {
         loop {
             let vol = self.vol.as_mut()?;
-            let (t, tv, sized) = vol.queues.iter_mut().rev().find_map(|q| q.pop_front())?;
+            let (t, tv, f) = vol.queues.iter_mut().rev().find_map(|q| q.pop_front())?;
             if self.dt.is_alive(t) && self.dt.tet(t) == tv {
-                return Some((t, sized));
+                return Some((t, (!f.is_nan()).then_some(f)));
             }
         }
     }
@@ -387,9 +394,12 @@ impl SurfaceMesher<'_> {
         let n = vol.deferrals.entry(key).or_default();
         *n += 1;
         if *n <= MAX_CELL_DEFERRALS {
-            let (class, sized) = self.cell_class(t, sized);
+            // The refined surface may have replaced the cell: its spacing is reused only if
+            // it is still there.
+            let same = self.dt.is_alive(t) && self.dt.tet(t) == tv;
+            let (class, sized) = self.cell_class(t, sized.filter(|_| same));
             if let Some(vol) = self.vol.as_mut() {
-                vol.queues[class.unwrap_or(SIZE)].push_back((t, tv, sized));
+                vol.queues[class.unwrap_or(SIZE)].push_back(queued(t, tv, sized));
             }
         }
     }
