@@ -596,9 +596,13 @@ impl<'a> SurfaceMesher<'a> {
         self.input_samples();
         boundary.input_samples = self.input_samples.take();
         // The cell level's queues and maps are freed before the output is built.
-        let spacing = self.vol.take().and_then(|v| v.spacing);
+        let (spacing, refusals) = match self.vol.take() {
+            Some(v) => (v.spacing, v.refusals),
+            None => (None, Default::default()),
+        };
         let mut volume = self.volume_mesh(&boundary)?;
         volume.spacing = spacing;
+        volume.refusals = refusals;
         volume.seconds_surface = seconds_surface;
         volume.seconds_volume = start.elapsed().as_secs_f64() - seconds_surface;
         Ok((boundary, volume))
@@ -1181,6 +1185,8 @@ pub struct VolumeMesh {
     pub regions: Vec<u32>,
     /// The cells' spacing when the caller gave none (graded from the surface).
     pub spacing: Option<crate::refine::AutoSpacing>,
+    /// How often the cell level left a bad cell as it was, per reason.
+    pub refusals: crate::run::report::Refusals,
     /// Time spent on the surface alone, then on the cells (with the surface refinement they
     /// caused).
     pub seconds_surface: f64,
