@@ -319,6 +319,7 @@ fn mesh_restricted(
         seconds_total: start.elapsed().as_secs_f64(),
         n_acute_angles: remeshed.small_corner_vertices.len(),
         stop_reason: remeshed.stop_reason.clone(),
+        refusals: volume.refusals,
         ..Report::default()
     };
     Ok((remeshed, mesh, report, volume.spacing))

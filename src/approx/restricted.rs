@@ -199,14 +199,10 @@ pub struct SurfaceMesher<'a> {
     criteria: SurfaceCriteria,
     dt: Delaunay,
     loc: Vec<Loc>,
-    subsegs: FxHashMap<[u32; 2], SubSeg>,
-    seg_queue: Vec<[u32; 2]>,
-    force_split: FxHashSet<[u32; 2]>,
-    facets: BinaryHeap<Queued>,
-    /// Subsegments too short to split further (their ends would coincide in floating point).
-    frozen: FxHashSet<[u32; 2]>,
-    /// How often each facet waited for subsegment splits (see `MAX_DEFERRALS`).
-    deferrals: FxHashMap<[u32; 3], u32>,
+    /// The subsegment level (the feature curves).
+    segs: SegmentLevel,
+    /// The surface level (the restricted facets).
+    surf: SurfaceLevel,
     bad_spacing: Option<MeshError>,
     min_length: f64,
     /// Sides, circumcentres and restricted facets, kept up to date (`tracking`).
@@ -226,6 +222,29 @@ pub struct SurfaceMesher<'a> {
     /// The caps of `Params::marker_sizes`, applied to the cells' automatic spacing (`spacing`
     /// holds them already).
     marker_caps: Option<&'a MarkerCaps>,
+}
+
+/// The subsegment level's state: the feature curves' subsegments and the ones to look at
+/// (`SurfaceMesher::refine` works them off first).
+#[derive(Default)]
+struct SegmentLevel {
+    /// Every subsegment, by its ends (`key2`).
+    all: FxHashMap<[u32; 2], SubSeg>,
+    /// Subsegments to check (a stack).
+    queue: Vec<[u32; 2]>,
+    /// Subsegments a facet or cell encroached: split when checked.
+    force_split: FxHashSet<[u32; 2]>,
+    /// Subsegments too short to split further (their ends would coincide in floating point).
+    frozen: FxHashSet<[u32; 2]>,
+}
+
+/// The surface level's state: the bad restricted facets (largest first), refined once no
+/// subsegment is queued.
+#[derive(Default)]
+struct SurfaceLevel {
+    queue: BinaryHeap<Queued>,
+    /// How often each facet waited for subsegment splits (see `MAX_DEFERRALS`).
+    deferrals: FxHashMap<[u32; 3], u32>,
 }
 
 /// The surface spacing's bound by the input's thickness, per input triangle.
@@ -311,12 +330,8 @@ impl<'a> SurfaceMesher<'a> {
             criteria,
             dt: Delaunay::default(),
             loc: vec![],
-            subsegs: FxHashMap::default(),
-            seg_queue: vec![],
-            force_split: FxHashSet::default(),
-            facets: BinaryHeap::new(),
-            frozen: FxHashSet::default(),
-            deferrals: FxHashMap::default(),
+            segs: SegmentLevel::default(),
+            surf: SurfaceLevel::default(),
             bad_spacing: None,
             min_length: 1e-9 * diagonal,
             track: tracking::Tracking::default(),
@@ -353,8 +368,8 @@ impl<'a> SurfaceMesher<'a> {
         let (dt, _) = Delaunay::from_points(&points)
             .map_err(|e| MeshError::InvalidInput(format!("surface samples: {e}")))?;
         m.dt = dt;
-        m.seg_queue = {
-            let mut keys: Vec<[u32; 2]> = m.subsegs.keys().copied().collect();
+        m.segs.queue = {
+            let mut keys: Vec<[u32; 2]> = m.segs.all.keys().copied().collect();
             keys.sort_unstable();
             keys.reverse();
             keys
@@ -478,7 +493,7 @@ impl<'a> SurfaceMesher<'a> {
         }
         ids.push(corner(curve.ends[1]));
         for k in 0..ids.len() - 1 {
-            self.subsegs.insert(
+            self.segs.all.insert(
                 key2(ids[k], ids[k + 1]),
                 SubSeg {
                     curve: ci,
@@ -596,9 +611,13 @@ impl<'a> SurfaceMesher<'a> {
         self.input_samples();
         boundary.input_samples = self.input_samples.take();
         // The cell level's queues and maps are freed before the output is built.
-        let spacing = self.vol.take().and_then(|v| v.spacing);
+        let (spacing, refusals) = match self.vol.take() {
+            Some(v) => (v.spacing, v.refusals),
+            None => (None, Default::default()),
+        };
         let mut volume = self.volume_mesh(&boundary)?;
         volume.spacing = spacing;
+        volume.refusals = refusals;
         volume.seconds_surface = seconds_surface;
         volume.seconds_volume = start.elapsed().as_secs_f64() - seconds_surface;
         Ok((boundary, volume))
@@ -708,12 +727,12 @@ impl<'a> SurfaceMesher<'a> {
             if self.bad_spacing.is_some() {
                 return None;
             }
-            if let Some(k) = self.seg_queue.pop() {
+            if let Some(k) = self.segs.queue.pop() {
                 self.check_subseg(k);
                 continue;
             }
             // Both queues empty: done, no stop reason.
-            let q = self.facets.pop()?;
+            let q = self.surf.queue.pop()?;
             self.refine_facet(q.face, q.sized);
         }
     }
@@ -725,13 +744,13 @@ impl<'a> SurfaceMesher<'a> {
     }
 
     fn check_subseg(&mut self, k: [u32; 2]) {
-        let Some(ss) = self.subsegs.get(&k).copied() else {
+        let Some(ss) = self.segs.all.get(&k).copied() else {
             return;
         };
-        if self.frozen.contains(&k) {
+        if self.segs.frozen.contains(&k) {
             return;
         }
-        let forced = self.force_split.remove(&k);
+        let forced = self.segs.force_split.remove(&k);
         let [a, b] = ss.ends.map(|v| self.dt.point(v));
         let curve = &self.curves.curves[ss.curve as usize];
         let split = forced
@@ -765,7 +784,7 @@ impl<'a> SurfaceMesher<'a> {
         let len = ss.s[1] - ss.s[0];
         let curve = &self.curves.curves[ss.curve as usize];
         if (self.dt.point(k[0]) - self.dt.point(k[1])).length() < self.min_length {
-            self.frozen.insert(k);
+            self.segs.frozen.insert(k);
             return;
         }
         let is_corner = |v: u32| matches!(self.loc[v as usize], Loc::Corner(_));
@@ -783,18 +802,18 @@ impl<'a> SurfaceMesher<'a> {
         let id = match self.dt.insert(p, hint) {
             Ok(Inserted::New(id)) => id,
             _ => {
-                self.frozen.insert(k);
+                self.segs.frozen.insert(k);
                 return;
             }
         };
         self.loc.push(Loc::Curve(ss.curve));
         debug_assert_eq!(self.loc.len(), id as usize + 1);
-        self.subsegs.remove(&k);
+        self.segs.all.remove(&k);
         for (e, sp) in [
             ([ss.ends[0], id], [ss.s[0], s]),
             ([id, ss.ends[1]], [s, ss.s[1]]),
         ] {
-            self.subsegs.insert(
+            self.segs.all.insert(
                 key2(e[0], e[1]),
                 SubSeg {
                     curve: ss.curve,
@@ -802,7 +821,7 @@ impl<'a> SurfaceMesher<'a> {
                     ends: e,
                 },
             );
-            self.seg_queue.push(key2(e[0], e[1]));
+            self.segs.queue.push(key2(e[0], e[1]));
         }
         self.after_insertion();
     }
@@ -822,8 +841,8 @@ impl<'a> SurfaceMesher<'a> {
                         continue; // subsegments join curve and corner vertices only
                     }
                     let k = key2(tv[i], tv[j]);
-                    if self.subsegs.contains_key(&k) && seen.insert(k) {
-                        self.seg_queue.push(k);
+                    if self.segs.all.contains_key(&k) && seen.insert(k) {
+                        self.segs.queue.push(k);
                     }
                 }
             }
@@ -953,7 +972,7 @@ impl<'a> SurfaceMesher<'a> {
                     }
                 };
                 if bad != Bad::No {
-                    self.facets.push(Queued {
+                    self.surf.queue.push(Queued {
                         radius: r.radius,
                         face: key3(r.vertices),
                         sized,
@@ -1055,16 +1074,16 @@ impl<'a> SurfaceMesher<'a> {
         if !encroached.is_empty() {
             // A centre on a feature curve encroaches its subsegments at every scale: after
             // MAX_DEFERRALS rounds of splits the facet is left as it is.
-            let n = self.deferrals.entry(key3(r.vertices)).or_default();
+            let n = self.surf.deferrals.entry(key3(r.vertices)).or_default();
             *n += 1;
             if *n > MAX_DEFERRALS {
                 return Outcome::Refused(Refusal::Cascade);
             }
             for k in encroached {
-                self.force_split.insert(k);
-                self.seg_queue.push(k);
+                self.segs.force_split.insert(k);
+                self.segs.queue.push(k);
             }
-            self.facets.push(Queued {
+            self.surf.queue.push(Queued {
                 radius: r.radius,
                 face: key3(r.vertices),
                 sized: None,
@@ -1111,10 +1130,10 @@ impl<'a> SurfaceMesher<'a> {
                         continue;
                     }
                     let k = key2(tv[i], tv[j]);
-                    if out.contains(&k) || self.frozen.contains(&k) {
+                    if out.contains(&k) || self.segs.frozen.contains(&k) {
                         continue;
                     }
-                    if !self.subsegs.contains_key(&k) {
+                    if !self.segs.all.contains_key(&k) {
                         continue;
                     }
                     let (a, b) = (self.dt.point(k[0]), self.dt.point(k[1]));
@@ -1161,7 +1180,8 @@ impl<'a> SurfaceMesher<'a> {
             out.input_triangle.push(triangle);
         }
         let mut edges: Vec<[u32; 2]> = self
-            .subsegs
+            .segs
+            .all
             .keys()
             .filter_map(|k| Some(key2(*new_id.get(&k[0])?, *new_id.get(&k[1])?)))
             .collect();
@@ -1181,6 +1201,8 @@ pub struct VolumeMesh {
     pub regions: Vec<u32>,
     /// The cells' spacing when the caller gave none (graded from the surface).
     pub spacing: Option<crate::refine::AutoSpacing>,
+    /// How often the cell level left a bad cell as it was, per reason.
+    pub refusals: crate::run::report::Refusals,
     /// Time spent on the surface alone, then on the cells (with the surface refinement they
     /// caused).
     pub seconds_surface: f64,

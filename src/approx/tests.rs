@@ -196,6 +196,21 @@ fn approximate_mode_is_deterministic() {
     assert_eq!(a, b);
 }
 
+/// The cell level's refusals reach the report: fandisk asked for 25 degrees leaves a few bad
+/// cells, each counted under its reason (the total is their sum).
+#[test]
+fn cell_level_refusals_are_reported() {
+    let params = Params {
+        min_dihedral: 25.0,
+        ..approximate()
+    };
+    let input = model("off/fandisk.off");
+    let (_, _, report) = crate::pipeline::mesh(&input, &params, None, None).unwrap();
+    let r = &report.refusals;
+    assert!(r.total > 0, "{r:?}");
+    assert_eq!(r.total, r.counts().iter().map(|&(_, n)| n).sum::<usize>());
+}
+
 /// Bad input is refused as in keep mode, naming what is wrong.
 #[test]
 fn open_surface_is_refused_in_approximate_mode() {

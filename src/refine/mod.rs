@@ -14,6 +14,7 @@ pub(crate) mod outcome;
 mod output;
 mod plc_level;
 mod quality;
+pub(crate) mod queue;
 mod recover;
 pub mod report;
 mod spacing;

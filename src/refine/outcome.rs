@@ -73,6 +73,9 @@ pub(crate) enum Refusal {
     /// The circumcentre of the subfacet to split lies outside its facet and encroaches none
     /// of its subsegments.
     SubfacetCentreOutside,
+    /// Its point encroached the boundary each time it was looked at, the boundary was refined
+    /// for it as many times as allowed, and it is left (the approximate mode's cell level).
+    WaitedForBoundary,
 }
 
 impl Refusal {
@@ -101,6 +104,7 @@ impl Refusal {
             Refusal::CentroidCascade => &mut counts.centroid_cascade,
             Refusal::FlatSubfacet => &mut counts.flat_subfacet,
             Refusal::SubfacetCentreOutside => &mut counts.subfacet_centre_outside,
+            Refusal::WaitedForBoundary => &mut counts.waited_for_boundary,
         };
         *slot += 1;
         counts.total += 1;
@@ -117,7 +121,7 @@ mod tests {
     use super::*;
     use crate::run::report::Refusals;
 
-    const ALL: [Refusal; 13] = [
+    const ALL: [Refusal; 14] = [
         Refusal::Futile,
         Refusal::FlatByConstruction,
         Refusal::NoCircumsphere,
@@ -131,6 +135,7 @@ mod tests {
         Refusal::CentroidCascade,
         Refusal::FlatSubfacet,
         Refusal::SubfacetCentreOutside,
+        Refusal::WaitedForBoundary,
     ];
 
     /// Every reason is counted in a field of its own, named in `counts` as in the JSON report,

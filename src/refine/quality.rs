@@ -8,14 +8,17 @@
 //! is asked through [`FacetLevel`] (`plc_level.rs`), and Li's point choice is `levels.rs`'s.
 //!
 //! Refining one bad tet (`refine_tet` and the helpers it returns through) decides and says
-//! what it did as an [`Outcome`]; `run`, the queue loop, keeps all the books (counts per
-//! refusal reason, the deferred queue, the tets left at once when looked at again).
+//! what it did as an [`Outcome`]; the loop is `queue::work_off`'s (shared with the approximate
+//! mode's cell level), which counts the refusals per reason, and `Refiner`'s
+//! [`BadLevel::record`] keeps the level's own books (the deferred queue, the tets left at once
+//! when looked at again).
 
 use super::domain::{Domain, VertexKind};
 use super::levels::{pick_in_ball, Conflict, FacetLevel, Picker, Request};
 use super::mark::Regions;
 use super::outcome::{Outcome, Refusal};
 use super::plc_level::Boundary;
+use super::queue::{work_off, BadLevel, BadQueues, Class, Ended};
 use super::recover::Settled;
 use crate::delaunay::{Cavity, Probe};
 use crate::geom::screen::{longest_edge_direct as longest_edge, sliver_measures};
@@ -28,19 +31,18 @@ use glam::DVec3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rustc_hash::FxHashSet;
-use std::collections::VecDeque;
 
-/// Badness classes, in refinement priority order.
-const SIZE: u8 = 2;
-const RATIO: u8 = 1;
-const SLIVER: u8 = 0;
+/// Badness classes, in refinement priority order (the highest first).
+const SIZE: Class = Class::Size;
+const RATIO: Class = Class::Ratio;
+const SLIVER: Class = Class::Sliver;
 
 /// A queued bad tet: its class (which queue) and the tet as it was when judged (a tet id is
 /// reused once the tet is gone, so the vertices tell whether it is still the same tet). 24
 /// bytes: the queues hold up to about one entry per tet of the final mesh.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-struct Bad {
-    class: u8,
+pub(crate) struct Bad {
+    class: Class,
     tet: u32,
     verts: [u32; 4],
 }
@@ -84,11 +86,9 @@ pub struct Refiner<'a> {
     pub regions: &'a Regions,
     /// Li's point choice (small slivers, random draws), shared with the facet level's splits.
     picker: Picker,
-    /// One FIFO queue per badness class; the highest class is served first.
-    queues: [VecDeque<Bad>; 3],
-    /// Flat tets with a far circumcentre, served after every queue is empty
-    /// ([`Outcome::Deferred`]).
-    deferred: VecDeque<Bad>,
+    /// One FIFO queue per badness class, the highest class served first, then the flat tets
+    /// with a far circumcentre ([`Outcome::Deferred`]), served after every queue is empty.
+    queues: BadQueues<Bad>,
     /// How often a bad tet was left alone, per reason.
     pub refusals: Refusals,
     /// Bad tets (vertex quadruples) left alone within a small input angle's influence
@@ -148,8 +148,7 @@ impl<'a> Refiner<'a> {
             params,
             spacing,
             regions,
-            queues: Default::default(),
-            deferred: VecDeque::new(),
+            queues: BadQueues::default(),
             refusals: Refusals::default(),
             blocked_by_small_angle: FxHashSet::default(),
             futile: FxHashSet::default(),
@@ -347,46 +346,22 @@ impl<'a> Refiner<'a> {
                     }
                 };
                 if let Some(b) = b {
-                    self.queues[b.class as usize].push_back(b);
+                    self.queues.push(b.class, b);
                 }
             }
         }
         Ok(())
     }
 
-    /// The next bad tet, and whether it was deferred already.
-    fn next_bad(&mut self) -> Option<(Bad, bool)> {
-        if let Some(b) = self.queues.iter_mut().rev().find_map(|q| q.pop_front()) {
-            return Some((b, false));
-        }
-        self.deferred.pop_front().map(|b| (b, true))
-    }
-
-    /// Runs the refinement until no bad tet is left or a budget stops it.
+    /// Runs the refinement until no bad tet is left or a budget stops it (the loop is
+    /// `queue::work_off`'s, with this level's hooks).
     pub fn run(&mut self, progress: &mut dyn FnMut(usize) -> bool) -> Result<(), MeshError> {
         let all: Vec<u32> = self.dom.dt.finite_tet_ids().collect();
         self.push_tets(&all)?;
-        let mut steps = 0usize;
-        while let Some((bad, was_deferred)) = self.next_bad() {
-            if !self.is_current(bad) {
-                continue;
-            }
-            if self.dom.dt.num_vertices() >= self.params.max_vertices {
-                let max = self.params.max_vertices;
-                self.stop(format!("vertex budget max_vertices = {max} reached"), bad);
-                return Ok(());
-            }
-            steps += 1;
-            if steps % 1024 == 0 && !progress(self.dom.dt.num_vertices()) {
-                return Err(MeshError::Cancelled);
-            }
-            let before = self.dom.dt.num_vertices();
-            let outcome = self.refine_tet(bad, !was_deferred)?;
-            if !self.record(bad, outcome, before)? {
-                return Ok(());
-            }
+        match work_off(self, progress)? {
+            Ended::Cancelled => Err(MeshError::Cancelled),
+            Ended::Done | Ended::Stopped => Ok(()),
         }
-        Ok(())
     }
 
     /// Whether queued bad tet `bad` is still a tet of the mesh.
@@ -394,45 +369,10 @@ impl<'a> Refiner<'a> {
         self.dom.dt.is_alive(bad.tet) && self.dom.dt.tet(bad.tet) == bad.verts
     }
 
-    /// The books of one refined bad tet (`n_before`: the vertex count before), all kept here:
-    /// refusals counted per reason, the tets left within a small angle's influence or left for
-    /// good, the deferred queue, and a second look at a tet that survived a split. Returns
-    /// false when refinement must stop.
-    fn record(&mut self, bad: Bad, outcome: Outcome, n_before: usize) -> Result<bool, MeshError> {
-        match outcome {
-            Outcome::Refused(reason) => {
-                reason.count(&mut self.refusals);
-                if reason.remembered() {
-                    self.futile.insert(sorted4(bad.verts));
-                }
-                if reason.within_small_angle() {
-                    self.blocked_by_small_angle.insert(sorted4(bad.verts));
-                }
-            }
-            Outcome::Deferred => self.deferred.push_back(bad),
-            Outcome::BudgetSpent => {
-                let max = super::recover::MAX_RECOVERY_SPLITS;
-                self.stop(
-                    format!("boundary split budget ({max} splits after one insertion) spent"),
-                    bad,
-                );
-                return Ok(false);
-            }
-            Outcome::Inserted | Outcome::Split(_) | Outcome::Queued(_) | Outcome::Resettled => {
-                // A boundary split need not destroy the tet that asked for it: look again
-                // (only if something was inserted, or it would come back forever).
-                if self.dom.dt.num_vertices() > n_before && self.is_current(bad) {
-                    self.push_tets(&[bad.tet])?;
-                }
-            }
-        }
-        Ok(true)
-    }
-
     /// Stops refinement for `reason` (a budget), counting the bad tets still queued (`bad`
     /// among them while it is a tet) as left by the budget.
     fn stop(&mut self, reason: String, bad: Bad) {
-        let queued = self.queues.iter().flatten().chain(&self.deferred);
+        let queued = self.queues.iter();
         let left: FxHashSet<u32> = std::iter::once(&bad)
             .chain(queued)
             .filter(|b| self.is_current(**b))
@@ -663,6 +603,74 @@ impl<'a> Refiner<'a> {
             }
             outcome => outcome,
         })
+    }
+}
+
+impl BadLevel for Refiner<'_> {
+    type Bad = Bad;
+    type Error = MeshError;
+
+    fn queues(&mut self) -> &mut BadQueues<Bad> {
+        &mut self.queues
+    }
+
+    fn still_bad(&mut self, bad: &mut Bad) -> bool {
+        self.is_current(*bad)
+    }
+
+    fn within_budget(&mut self, bad: &Bad) -> bool {
+        if self.dom.dt.num_vertices() < self.params.max_vertices {
+            return true;
+        }
+        let max = self.params.max_vertices;
+        self.stop(format!("vertex budget max_vertices = {max} reached"), *bad);
+        false
+    }
+
+    fn num_vertices(&self) -> usize {
+        self.dom.dt.num_vertices()
+    }
+
+    fn refine(&mut self, bad: Bad, deferred: bool) -> Result<Outcome, MeshError> {
+        self.refine_tet(bad, !deferred)
+    }
+
+    fn refusals(&mut self) -> &mut Refusals {
+        &mut self.refusals
+    }
+
+    /// The books of one refined bad tet (`n_before`: the vertex count before; a refusal is
+    /// counted already): the tets left within a small angle's influence or left for good,
+    /// the deferred queue, and a second look at a tet that survived a split. Returns false
+    /// when refinement must stop.
+    fn record(&mut self, bad: Bad, outcome: Outcome, n_before: usize) -> Result<bool, MeshError> {
+        match outcome {
+            Outcome::Refused(reason) => {
+                if reason.remembered() {
+                    self.futile.insert(sorted4(bad.verts));
+                }
+                if reason.within_small_angle() {
+                    self.blocked_by_small_angle.insert(sorted4(bad.verts));
+                }
+            }
+            Outcome::Deferred => self.queues.defer(bad),
+            Outcome::BudgetSpent => {
+                let max = super::recover::MAX_RECOVERY_SPLITS;
+                self.stop(
+                    format!("boundary split budget ({max} splits after one insertion) spent"),
+                    bad,
+                );
+                return Ok(false);
+            }
+            Outcome::Inserted | Outcome::Split(_) | Outcome::Queued(_) | Outcome::Resettled => {
+                // A boundary split need not destroy the tet that asked for it: look again
+                // (only if something was inserted, or it would come back forever).
+                if self.dom.dt.num_vertices() > n_before && self.is_current(bad) {
+                    self.push_tets(&[bad.tet])?;
+                }
+            }
+        }
+        Ok(true)
     }
 }
 

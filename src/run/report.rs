@@ -119,7 +119,8 @@ pub struct SurfaceReport {
 
 /// How many times refinement left a bad tet as it was, per reason (a tet looked at again and
 /// left again counts again; many are removed later by other insertions), and how many bad
-/// tets a budget left queued. Keep mode and existing meshes; zero in approximate mode.
+/// tets a budget left queued. Keep mode, existing meshes, and the approximate mode's cell
+/// level.
 #[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize)]
 pub struct Refusals {
     /// The sum of all the counts below.
@@ -150,6 +151,9 @@ pub struct Refusals {
     pub flat_subfacet: usize,
     /// The subfacet's circumcentre lies outside its facet.
     pub subfacet_centre_outside: usize,
+    /// The approximate mode's cell level: its point encroached the boundary, which was
+    /// refined for it, each of the times allowed.
+    pub waited_for_boundary: usize,
     /// Bad tets still queued when a budget (vertices, or boundary splits) stopped refinement.
     pub budget: usize,
 }
@@ -193,6 +197,7 @@ impl Refusals {
             centroid_cascade,
             flat_subfacet,
             subfacet_centre_outside,
+            waited_for_boundary,
             budget,
         } = o;
         self.total += total;
@@ -209,11 +214,12 @@ impl Refusals {
         self.centroid_cascade += centroid_cascade;
         self.flat_subfacet += flat_subfacet;
         self.subfacet_centre_outside += subfacet_centre_outside;
+        self.waited_for_boundary += waited_for_boundary;
         self.budget += budget;
     }
 
     /// The counts by reason (without the total), named as in the JSON report.
-    pub fn counts(&self) -> [(&'static str, usize); 14] {
+    pub fn counts(&self) -> [(&'static str, usize); 15] {
         let Refusals {
             total: _,
             futile,
@@ -229,6 +235,7 @@ impl Refusals {
             centroid_cascade,
             flat_subfacet,
             subfacet_centre_outside,
+            waited_for_boundary,
             budget,
         } = *self;
         [
@@ -245,6 +252,7 @@ impl Refusals {
             ("centroid_cascade", centroid_cascade),
             ("flat_subfacet", flat_subfacet),
             ("subfacet_centre_outside", subfacet_centre_outside),
+            ("waited_for_boundary", waited_for_boundary),
             ("budget", budget),
         ]
     }

@@ -90,8 +90,8 @@ impl FacetLevel for SurfaceMesher<'_> {
             Encroached::Facet(r, hint) => self.insert_surface_point(r, hint, Bad::Size),
             Encroached::Subsegments(keys) => {
                 for k in keys {
-                    self.force_split.insert(k);
-                    self.seg_queue.push(k);
+                    self.segs.force_split.insert(k);
+                    self.segs.queue.push(k);
                 }
                 Outcome::Queued(BoundaryKind::Segment)
             }

@@ -19,13 +19,16 @@ use crate::geom::screen::{shortest_edge_sq, sliver_measures};
 use crate::refine::levels::{
     pick_in_ball, Conflict, FacetLevel, GiveUp, Picker, Request, SliverBounds,
 };
+use crate::refine::outcome::{Outcome, Refusal};
+use crate::refine::queue::{work_off, BadLevel, BadQueues, Class, Ended};
 use crate::refine::{AutoSpacing, MarkerCapped};
+use crate::run::error::MeshError;
+use crate::run::report::Refusals;
 use crate::run::spacing::Spacing;
 use glam::DVec3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use rustc_hash::FxHashMap;
-use std::collections::VecDeque;
+use rustc_hash::{FxHashMap, FxHashSet};
 
 /// What the cell level aims for (from `run::params::Params`).
 #[derive(Debug, Clone, Copy)]
@@ -45,18 +48,17 @@ pub struct VolumeCriteria {
     pub seed: u64,
 }
 
-/// A cell's circumcentre and the spacing there, as evaluated when it was classified (looked
-/// at again with the same centre, the cell reuses the value instead of a second evaluation).
 /// The spacing a cell was classified with, reused while the cell (its id and vertices) is the
 /// same: its circumcentre is then the same point.
 type Sized = Option<f64>;
 
-/// A queued bad cell: id, vertices, and its [`Sized`] value (NaN for none; 32 bytes, as the
-/// queues hold up to about one entry per tet of the final mesh).
-type Queued = (u32, [u32; 4], f64);
+/// [`Sized`] as a queue entry stores it: NaN for none (8 bytes instead of 16).
+fn stored(sized: Sized) -> f64 {
+    sized.unwrap_or(f64::NAN)
+}
 
-fn queued(t: u32, tv: [u32; 4], sized: Sized) -> Queued {
-    (t, tv, sized.unwrap_or(f64::NAN))
+fn unstored(f: f64) -> Sized {
+    (!f.is_nan()).then_some(f)
 }
 
 /// The most cells classified with one batched spacing evaluation (`Spacing::at_many`).
@@ -65,15 +67,15 @@ const SPACING_BATCH: usize = crate::refine::SPACING_BATCH;
 /// A cell's classification before its spacing is known.
 enum CellStep {
     /// Good, outside, or next to a small corner.
-    Done(Option<usize>),
+    Done(Option<Class>),
     /// The spacing at the circumcentre `centre` (radius `r`) decides.
     Need { centre: DVec3, r: f64 },
 }
 
-/// Cell classes, in the order they are refined (the last queue first).
-const SLIVER: usize = 0;
-const RATIO: usize = 1;
-const SIZE: usize = 2;
+/// A queued bad cell: id, vertices (as when it was judged), and the spacing it was classified
+/// with ([`stored`]; 32 bytes, as the queues hold up to about one entry per tet of the final
+/// mesh).
+pub(super) type Cell = (u32, [u32; 4], f64);
 
 /// Times a cell may wait for the surface or a subsegment to be refined for it before it is
 /// left as it is.
@@ -93,8 +95,10 @@ pub(super) struct VolumeState {
     slivers: SliverBounds,
     /// Li's point choice (small slivers, random draws); None while lent out.
     picker: Option<Picker>,
-    /// Bad cells: id, vertices, and the spacing at the circumcentre they were classified with.
-    queues: [VecDeque<Queued>; 3],
+    /// Bad cells per class, the highest served first (`refine::queue`).
+    queues: BadQueues<Cell>,
+    /// How often a bad cell was left as it was, per reason (the run's report).
+    pub(super) refusals: Refusals,
     deferrals: FxHashMap<[u32; 4], u8>,
     pub(super) spacing: Option<AutoSpacing>,
     /// Per vertex id: within a small corner's ball (cells there are left as they are).
@@ -127,7 +131,8 @@ impl SurfaceMesher<'_> {
                 )
                 .giving_up(APPROX_GIVE_UP),
             ),
-            queues: Default::default(),
+            queues: BadQueues::default(),
+            refusals: Refusals::default(),
             deferrals: FxHashMap::default(),
             spacing,
             near_small: vec![],
@@ -220,7 +225,7 @@ impl SurfaceMesher<'_> {
                 if let Some(class) = class {
                     let tv = self.dt.tet(t);
                     if let Some(vol) = self.vol.as_mut() {
-                        vol.queues[class].push_back(queued(t, tv, sized));
+                        vol.queues.push(class, (t, tv, stored(sized)));
                     }
                 }
             }
@@ -245,7 +250,7 @@ impl SurfaceMesher<'_> {
     /// The class of a bad inside cell, or None when it is good, outside or next to a small
     /// corner; `sized`: the spacing this same cell was classified with before (the caller
     /// checks that it is the same), reused. Returns the spacing used too.
-    fn cell_class(&self, t: u32, sized: Sized) -> (Option<usize>, Sized) {
+    fn cell_class(&self, t: u32, sized: Sized) -> (Option<Class>, Sized) {
         match self.prepare_cell(t) {
             CellStep::Done(class) => (class, None),
             CellStep::Need { centre, r } => {
@@ -281,137 +286,224 @@ impl SurfaceMesher<'_> {
     }
 
     /// The rest of [`Self::cell_class`], given `f` at the circumcentre (radius `r`).
-    fn finish_cell(&self, t: u32, r: f64, f: f64) -> Option<usize> {
+    fn finish_cell(&self, t: u32, r: f64, f: f64) -> Option<Class> {
         let vol = self.vol.as_ref()?;
         let f = match self.region_caps.get(self.region_of(t) as usize) {
             Some(&cap) => f.min(cap),
             None => f,
         };
         if r > vol.crit.size_factor * f {
-            return Some(SIZE);
+            return Some(Class::Size);
         }
         let tv = self.dt.tet(t);
         let [a, b, c, d] = tv.map(|v| self.dt.point(v));
         let l2 = shortest_edge_sq(a, b, c, d);
         if r * r > vol.crit.rho0 * vol.crit.rho0 * l2 {
-            return Some(RATIO);
+            return Some(Class::Ratio);
         }
         let (sigma, max_cos) = sliver_measures(a, b, c, d, l2);
-        vol.slivers.is_sliver(sigma, max_cos).then_some(SLIVER)
+        vol.slivers
+            .is_sliver(sigma, max_cos)
+            .then_some(Class::Sliver)
     }
 
-    /// The next bad cell still present, largest class first, with the spacing it was
-    /// classified with.
-    fn next_cell(&mut self) -> Option<(u32, Sized)> {
-        loop {
-            let vol = self.vol.as_mut()?;
-            let (t, tv, f) = vol.queues.iter_mut().rev().find_map(|q| q.pop_front())?;
-            if self.dt.is_alive(t) && self.dt.tet(t) == tv {
-                return Some((t, (!f.is_nan()).then_some(f)));
-            }
-        }
-    }
-
-    /// Runs both levels until no bad facet, subsegment or cell is left (or a budget stops it).
+    /// Runs both levels until no bad facet, subsegment or cell is left (or a budget stops it):
+    /// `refine::queue::work_off` over the cells ([`CellLevel`]), the surface and subsegment
+    /// levels worked off before each cell.
     pub(super) fn refine_volume(
         &mut self,
         progress: &mut Option<crate::run::progress::Progress>,
     ) -> Option<String> {
-        let mut steps = 0usize;
-        loop {
-            steps += 1;
-            if steps % 1024 == 0 {
-                let n = self.dt.num_vertices();
-                if progress.as_mut().is_some_and(|p| !p(0.5, n)) {
-                    if let Some(vol) = self.vol.as_mut() {
-                        vol.cancelled = true;
-                    }
-                    return None;
+        if self.vol.as_ref().is_none_or(|v| v.cancelled) {
+            return None;
+        }
+        let mut level = CellLevel {
+            m: self,
+            stop: None,
+        };
+        let ended = work_off(&mut level, &mut |n| {
+            progress.as_mut().is_none_or(|p| p(0.5, n))
+        });
+        let stop = level.stop.take();
+        match ended {
+            Ok(Ended::Done) => None,
+            Ok(Ended::Stopped) => stop,
+            Ok(Ended::Cancelled) => {
+                if let Some(vol) = self.vol.as_mut() {
+                    vol.cancelled = true;
                 }
+                None
             }
-            if self.vol.as_ref().is_some_and(|v| v.cancelled) {
-                return None;
-            }
-            if let Some(reason) = self.refine() {
-                return Some(reason);
-            }
-            if self.bad_spacing.is_some() {
-                return None;
-            }
-            let (t, sized) = self.next_cell()?;
-            if let (Some(_), sized) = self.cell_class(t, sized) {
-                self.refine_cell(t, sized);
+            Err(e) => {
+                self.bad_spacing.get_or_insert(e);
+                None
             }
         }
     }
 
-    fn refine_cell(&mut self, t: u32, sized: Sized) {
+    /// Refines bad cell `t` (still bad, classified with `sized`) and says what it did.
+    fn refine_cell(&mut self, t: u32, sized: Sized) -> Result<Outcome, MeshError> {
         let tv = self.dt.tet(t);
         let Some((centre, r)) = self.sphere_of(t) else {
-            return;
+            return Ok(Outcome::Refused(Refusal::NoCircumsphere));
         };
         let Probe::Cavity(cavity) = self.dt.probe(centre, Some(t)) else {
-            return;
+            // The centre is a vertex already.
+            return Ok(Outcome::Refused(Refusal::Duplicate));
         };
         match self.conflict(&cavity, r, Request::Shape) {
             Conflict::Free => {}
             Conflict::Encroaches(e) => return self.yield_to_surface(t, tv, e, sized),
-            Conflict::Refused(_) => return,
+            Conflict::Refused(reason) => return Ok(Outcome::Refused(reason)),
         }
-        let Some(mut picker) = self.lend_picker() else {
-            return;
-        };
+        let mut picker = self.lend_picker();
         let centre = cavity.point();
         let picked = pick_in_ball(self, &mut picker, centre, Some(cavity), r, t);
         self.return_picker(picker);
+        // Not reached: the centre's cavity is a candidate, so one is always kept.
         let Some(cavity) = picked else {
-            return;
+            return Ok(Outcome::Refused(Refusal::Duplicate));
         };
-        if let Ok(Inserted::New(id)) = self.dt.insert_cavity(cavity) {
-            self.loc.push(Loc::Volume);
-            debug_assert_eq!(self.loc.len(), id as usize + 1);
-            self.after_insertion();
+        match self.dt.insert_cavity(cavity) {
+            Ok(Inserted::New(id)) => {
+                self.loc.push(Loc::Volume);
+                debug_assert_eq!(self.loc.len(), id as usize + 1);
+                self.after_insertion();
+                Ok(Outcome::Inserted)
+            }
+            // A draw on a vertex, or a degenerate insertion: nothing changed.
+            _ => Ok(Outcome::Refused(Refusal::Duplicate)),
         }
     }
 
     /// The surface or a subsegment is refined for cell `t` instead of it (the facet level
-    /// refines the facet now or queues the subsegments); the cell waits (a limited number of
-    /// times: next to a refusing facet it is left).
-    fn yield_to_surface(&mut self, t: u32, tv: [u32; 4], encroached: Encroached, sized: Sized) {
-        let Some(mut picker) = self.lend_picker() else {
-            return;
-        };
+    /// refines the facet now or queues the subsegments); the cell waits, queued again (a
+    /// limited number of times: then it is left, [`Refusal::WaitedForBoundary`]). Returns
+    /// the facet level's outcome while the cell waits.
+    fn yield_to_surface(
+        &mut self,
+        t: u32,
+        tv: [u32; 4],
+        encroached: Encroached,
+        sized: Sized,
+    ) -> Result<Outcome, MeshError> {
+        let mut picker = self.lend_picker();
         let outcome = self.refine_encroached(encroached, &mut picker);
         self.return_picker(picker);
-        if outcome.is_err() {
-            return;
-        }
-        let Some(vol) = self.vol.as_mut() else {
-            return;
-        };
+        let outcome = outcome?;
+        let vol = self.vol.as_mut().expect("the cell level is on");
         let mut key = tv;
         key.sort_unstable();
         let n = vol.deferrals.entry(key).or_default();
         *n += 1;
-        if *n <= MAX_CELL_DEFERRALS {
-            // The refined surface may have replaced the cell: its spacing is reused only if
-            // it is still there.
-            let same = self.dt.is_alive(t) && self.dt.tet(t) == tv;
-            let (class, sized) = self.cell_class(t, sized.filter(|_| same));
-            if let Some(vol) = self.vol.as_mut() {
-                vol.queues[class.unwrap_or(SIZE)].push_back(queued(t, tv, sized));
-            }
+        if *n > MAX_CELL_DEFERRALS {
+            return Ok(Outcome::Refused(Refusal::WaitedForBoundary));
         }
+        // The refined surface may have replaced the cell: its spacing is reused only if it is
+        // still there.
+        let same = self.dt.is_alive(t) && self.dt.tet(t) == tv;
+        let (class, sized) = self.cell_class(t, sized.filter(|_| same));
+        if let Some(vol) = self.vol.as_mut() {
+            vol.queues
+                .push(class.unwrap_or(Class::Size), (t, tv, stored(sized)));
+        }
+        Ok(outcome)
     }
 
     /// The cell level's picker, lent to a level function that takes the mesher too.
-    fn lend_picker(&mut self) -> Option<Picker> {
-        self.vol.as_mut()?.picker.take()
+    fn lend_picker(&mut self) -> Picker {
+        self.vol
+            .as_mut()
+            .and_then(|v| v.picker.take())
+            .expect("the cell level's picker is at hand")
     }
 
     fn return_picker(&mut self, picker: Picker) {
         if let Some(vol) = self.vol.as_mut() {
             vol.picker = Some(picker);
         }
+    }
+}
+
+/// The approximate mode's cell level as `refine::queue::work_off` drives it: the surface and
+/// subsegment levels below are worked off before each cell (`SurfaceMesher::refine`), and a
+/// cell is still bad when it is a tet of the mesh and [`SurfaceMesher::cell_class`] gives it a
+/// class (inside, not next to a small corner, bad for the criteria).
+struct CellLevel<'m, 'g> {
+    m: &'m mut SurfaceMesher<'g>,
+    /// Why a level below stopped (a budget).
+    stop: Option<String>,
+}
+
+impl CellLevel<'_, '_> {
+    fn vol(&mut self) -> &mut VolumeState {
+        self.m.vol.as_mut().expect("the cell level is on")
+    }
+
+    /// Counts the bad cells still queued when a budget stopped refinement.
+    fn count_left(&mut self) {
+        let m = &*self.m;
+        let Some(vol) = m.vol.as_ref() else {
+            return;
+        };
+        let left: FxHashSet<u32> = vol
+            .queues
+            .iter()
+            .filter(|&&(t, tv, _)| m.dt.is_alive(t) && m.dt.tet(t) == tv)
+            .map(|&(t, _, _)| t)
+            .collect();
+        let n = left.len();
+        self.vol().refusals.count_budget(n);
+    }
+}
+
+impl BadLevel for CellLevel<'_, '_> {
+    type Bad = Cell;
+    type Error = MeshError;
+
+    fn queues(&mut self) -> &mut BadQueues<Cell> {
+        &mut self.vol().queues
+    }
+
+    fn before_next(&mut self) -> bool {
+        if let Some(reason) = self.m.refine() {
+            self.stop = Some(reason);
+            self.count_left();
+            return false;
+        }
+        self.m.bad_spacing.is_none()
+    }
+
+    fn still_bad(&mut self, cell: &mut Cell) -> bool {
+        let (t, tv, sized) = *cell;
+        if !(self.m.dt.is_alive(t) && self.m.dt.tet(t) == tv) {
+            return false;
+        }
+        let (class, sized) = self.m.cell_class(t, unstored(sized));
+        cell.2 = stored(sized);
+        class.is_some()
+    }
+
+    fn within_budget(&mut self, _cell: &Cell) -> bool {
+        // The vertex budget is the levels' below (`before_next`).
+        true
+    }
+
+    fn num_vertices(&self) -> usize {
+        self.m.dt.num_vertices()
+    }
+
+    fn refine(&mut self, cell: Cell, _deferred: bool) -> Result<Outcome, MeshError> {
+        self.m.refine_cell(cell.0, unstored(cell.2))
+    }
+
+    fn refusals(&mut self) -> &mut Refusals {
+        &mut self.vol().refusals
+    }
+
+    fn record(&mut self, _cell: Cell, _outcome: Outcome, _n: usize) -> Result<bool, MeshError> {
+        // A waiting cell is queued again by `yield_to_surface`; the new cells by
+        // `after_insertion`.
+        Ok(true)
     }
 }

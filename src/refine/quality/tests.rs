@@ -1,6 +1,7 @@
 //! Tests of the quality refinement's decisions and books.
 
 use super::*;
+use crate::refine::queue::book;
 
 /// The unit cube meshed to a conforming boundary and marked: its domain and regions.
 fn settled_cube() -> (Domain, Regions) {
@@ -110,14 +111,14 @@ fn refusals_are_counted_and_cascades_remembered() {
         .judge(Boundary::Segment(seg.0, seg.1), 5.0 * rb, Request::Shape);
     let outcome = refiner.yield_to_boundary(t, conflict).unwrap().unwrap();
     assert_eq!(outcome, Outcome::Refused(Refusal::Cascade));
-    assert!(refiner.record(bad, outcome, n).unwrap());
+    assert!(book(&mut refiner, bad, outcome, n).unwrap());
     let again = refiner.refine_tet(bad, true).unwrap();
     assert_eq!(again, Outcome::Refused(Refusal::Futile));
-    assert!(refiner.record(bad, again, n).unwrap());
+    assert!(book(&mut refiner, bad, again, n).unwrap());
     let on_vertex = refiner.dom.point(0);
     let duplicate = refiner.insert_volume_point(on_vertex, 1.0, t).unwrap();
     assert_eq!(duplicate, Outcome::Refused(Refusal::Duplicate));
-    assert!(refiner.record(bad, duplicate, n).unwrap());
+    assert!(book(&mut refiner, bad, duplicate, n).unwrap());
     assert_eq!(refiner.dom.dt.num_vertices(), n);
     let r = &refiner.refusals;
     assert_eq!((r.cascade, r.futile, r.duplicate, r.total), (1, 1, 1, 3));
