@@ -2,24 +2,17 @@
 //! facets of marker ID get spacing about H, the spacing grows away from them
 //! (`refine::MARKER_GRADING`), the rest of the boundary keeps its own.
 
+mod common;
+
+use common::size_caps::run;
 use glam::DVec3;
 use slivermesh::mesh::TetMesh;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 const H: f64 = 0.05;
 
 fn model(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("models")
-        .join(name)
-}
-
-fn run(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_slivermesh"))
-        .args(args)
-        .output()
-        .unwrap()
+    common::models_dir().join(name)
 }
 
 fn mesh_with(input: &Path, mode: &str, extra: &[&str]) -> TetMesh {
@@ -170,34 +163,7 @@ fn marker_size_applies_where_markers_do_not_survive() {
 
 #[test]
 fn marker_size_errors_name_the_id_and_the_option() {
-    let input = model("poly/two_materials.poly");
-    let input = input.to_str().unwrap();
-    let out = std::env::temp_dir().join(format!("slivermesh-ms-err-{}.mesh", std::process::id()));
-    let out = out.to_str().unwrap();
-    for mode in ["keep", "approximate"] {
-        let o = run(&[
-            "mesh",
-            input,
-            "-o",
-            out,
-            "--surface",
-            mode,
-            "--marker-size",
-            "7:0.1",
-        ]);
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert!(!o.status.success());
-        assert!(
-            err.contains("marker 7") && err.contains("its markers: 1, 2"),
-            "{mode}: {err}"
-        );
-    }
-    for bad in ["2:0", "2:-1", "2:inf", "2:nan", "2", "x:1"] {
-        let o = run(&["mesh", input, "-o", out, "--marker-size", bad]);
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert!(!o.status.success());
-        assert!(err.contains("--marker-size"), "{bad}: {err}");
-    }
+    common::size_caps::check_unknown_ids_and_bad_values("--marker-size", "marker");
 }
 
 #[test]

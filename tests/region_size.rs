@@ -1,21 +1,14 @@
 //! `--region-size ID:H` (and `Mesher::set_region_size`): the tets of one region get spacing at
 //! most H, the other regions keep theirs.
 
+mod common;
+
+use common::size_caps::run;
 use slivermesh::mesh::TetMesh;
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::PathBuf;
 
 fn model(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("models")
-        .join(name)
-}
-
-fn run(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_slivermesh"))
-        .args(args)
-        .output()
-        .unwrap()
+    common::models_dir().join(name)
 }
 
 /// Mean edge length (edges counted once per tet) of the tets of each region: (region, count,
@@ -98,34 +91,7 @@ fn region_size_refines_one_region_only() {
 
 #[test]
 fn region_size_errors_name_the_id_and_the_option() {
-    let input = model("poly/two_materials.poly");
-    let input = input.to_str().unwrap();
-    let out = std::env::temp_dir().join(format!("slivermesh-rs-err-{}.mesh", std::process::id()));
-    let out = out.to_str().unwrap();
-    for mode in ["keep", "approximate"] {
-        let o = run(&[
-            "mesh",
-            input,
-            "-o",
-            out,
-            "--surface",
-            mode,
-            "--region-size",
-            "7:0.1",
-        ]);
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert!(!o.status.success());
-        assert!(
-            err.contains("region 7") && err.contains("its regions: 1, 2"),
-            "{mode}: {err}"
-        );
-    }
-    for bad in ["2:0", "2:-1", "2:inf", "2:nan", "2", "x:1"] {
-        let o = run(&["mesh", input, "-o", out, "--region-size", bad]);
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert!(!o.status.success());
-        assert!(err.contains("--region-size"), "{bad}: {err}");
-    }
+    common::size_caps::check_unknown_ids_and_bad_values("--region-size", "region");
 }
 
 #[test]

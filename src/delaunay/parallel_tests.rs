@@ -2,65 +2,7 @@
 //! (uniform, clustered, sphere points), valid and deterministic on degenerate grids.
 
 use super::*;
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
-
-fn uniform(n: usize, seed: u64) -> Vec<DVec3> {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    (0..n)
-        .map(|_| DVec3::new(rng.gen(), rng.gen(), rng.gen()))
-        .collect()
-}
-
-fn sorted_tets(dt: &Delaunay) -> Vec<[u32; 4]> {
-    let mut tets: Vec<[u32; 4]> = dt
-        .finite_tets()
-        .map(|mut t| {
-            t.sort_unstable();
-            t
-        })
-        .collect();
-    tets.sort_unstable();
-    tets
-}
-
-fn grid(k: usize) -> Vec<DVec3> {
-    let mut pts = vec![];
-    for x in 0..k {
-        for y in 0..k {
-            for z in 0..k {
-                pts.push(DVec3::new(x as f64, y as f64, z as f64));
-            }
-        }
-    }
-    pts
-}
-
-fn clustered(n: usize, seed: u64) -> Vec<DVec3> {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let centres: Vec<DVec3> = (0..5)
-        .map(|_| DVec3::new(rng.gen(), rng.gen(), rng.gen()))
-        .collect();
-    (0..n)
-        .map(|i| {
-            let c = centres[i % centres.len()];
-            let d = DVec3::new(rng.gen(), rng.gen(), rng.gen()) - 0.5;
-            c + d * 1e-3 * (1.0 + (i % 7) as f64)
-        })
-        .collect()
-}
-
-fn sphere(n: usize, seed: u64) -> Vec<DVec3> {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    (0..n)
-        .map(|_| loop {
-            let p = DVec3::new(rng.gen(), rng.gen(), rng.gen()) * 2.0 - 1.0;
-            if p.length_squared() > 0.01 && p.length_squared() <= 1.0 {
-                break p.normalize();
-            }
-        })
-        .collect()
-}
+use crate::delaunay::tests::{clustered, grid, sorted_tets, sphere, uniform};
 
 /// Triangulates `pts` with 1 thread and with each of `threads`, validates every result, and
 /// asserts the same tet set (and vertex pointers' validity) each time; returns the reports.

@@ -6,14 +6,16 @@ use crate::geom::insphere;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-fn uniform(n: usize, seed: u64) -> Vec<DVec3> {
+// The point sets and `sorted_tets` serve the parallel kernel's tests too (parallel_tests.rs).
+
+pub(super) fn uniform(n: usize, seed: u64) -> Vec<DVec3> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     (0..n)
         .map(|_| DVec3::new(rng.gen(), rng.gen(), rng.gen()))
         .collect()
 }
 
-fn grid(k: usize) -> Vec<DVec3> {
+pub(super) fn grid(k: usize) -> Vec<DVec3> {
     let mut pts = vec![];
     for x in 0..k {
         for y in 0..k {
@@ -25,7 +27,7 @@ fn grid(k: usize) -> Vec<DVec3> {
     pts
 }
 
-fn sphere(n: usize, seed: u64) -> Vec<DVec3> {
+pub(super) fn sphere(n: usize, seed: u64) -> Vec<DVec3> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     (0..n)
         .map(|_| loop {
@@ -37,7 +39,7 @@ fn sphere(n: usize, seed: u64) -> Vec<DVec3> {
         .collect()
 }
 
-fn clustered(n: usize, seed: u64) -> Vec<DVec3> {
+pub(super) fn clustered(n: usize, seed: u64) -> Vec<DVec3> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let centres: Vec<DVec3> = (0..5)
         .map(|_| DVec3::new(rng.gen(), rng.gen(), rng.gen()))
@@ -340,7 +342,7 @@ fn tags_are_inherited_through_cavities() {
 }
 
 /// Finite tets as sorted vertex quadruples, sorted (independent of tet ids and orientation).
-fn sorted_tets(dt: &Delaunay) -> Vec<[u32; 4]> {
+pub(super) fn sorted_tets(dt: &Delaunay) -> Vec<[u32; 4]> {
     let mut t: Vec<[u32; 4]> = dt
         .finite_tets()
         .map(|mut t| {

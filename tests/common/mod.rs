@@ -3,6 +3,7 @@
 
 pub mod corpus;
 pub mod dirty;
+pub mod size_caps;
 
 use slivermesh::geom::{insphere, orient3d};
 use slivermesh::mesh::TetMesh;
