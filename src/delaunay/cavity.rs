@@ -14,12 +14,8 @@ use glam::DVec3;
 /// Reusable buffers for cavity searches.
 #[derive(Debug, Clone, Default)]
 pub(super) struct Scratch {
-    /// Tets in conflict.
-    cavity: Vec<u32>,
-    /// For each cavity tet, the local index of the face it was reached through (4: start).
-    entry: Vec<u8>,
-    /// Cavity boundary faces.
-    boundary: Vec<BoundaryFace>,
+    /// The last search's cavity and boundary.
+    pub(super) search: SearchBuffers,
     /// Tets created by the last insertion.
     pub(super) created: Vec<u32>,
     /// Vertices of the tets the last insertion deleted.
@@ -49,9 +45,7 @@ struct KeptCavity {
 
 impl Scratch {
     pub(super) fn memory_bytes(&self) -> usize {
-        self.cavity.capacity() * 4
-            + self.entry.capacity()
-            + self.boundary.capacity() * std::mem::size_of::<BoundaryFace>()
+        self.search.memory_bytes()
             + self.created.capacity() * 4
             + self.removed.capacity() * 16
             + self.removed_ids.capacity() * 4
@@ -59,6 +53,65 @@ impl Scratch {
             + self.edges.memory_bytes()
             + self.kept.cavity.capacity() * 4
             + self.kept.boundary.capacity() * std::mem::size_of::<BoundaryFace>()
+    }
+}
+
+/// The lists a cavity search fills.
+#[derive(Debug, Clone, Default)]
+pub(super) struct SearchBuffers {
+    /// Tets in conflict.
+    pub(super) cavity: Vec<u32>,
+    /// For each cavity tet, the local index of the face it was reached through (4: start).
+    entry: Vec<u8>,
+    /// Cavity boundary faces.
+    pub(super) boundary: Vec<BoundaryFace>,
+}
+
+impl SearchBuffers {
+    pub(super) fn memory_bytes(&self) -> usize {
+        self.cavity.capacity() * 4
+            + self.entry.capacity()
+            + self.boundary.capacity() * std::mem::size_of::<BoundaryFace>()
+    }
+}
+
+/// Where a cavity search records the tets it visited ([`INSIDE`], [`OUTSIDE`], 0: not
+/// visited): the triangulation's mark array, or a search's own table when several search at
+/// once (`shared.rs`).
+pub(super) trait Marks {
+    fn get(&self, t: u32) -> u8;
+    fn set(&mut self, t: u32, m: u8);
+    /// Hints tet `t`'s mark into the cache.
+    fn prefetch(&self, t: u32);
+}
+
+/// The triangulation's one-byte mark per tet slot.
+pub(super) struct ArrayMarks<'a>(pub(super) &'a mut [u8]);
+
+impl Marks for ArrayMarks<'_> {
+    #[inline(always)]
+    fn get(&self, t: u32) -> u8 {
+        debug_assert!((t as usize) < self.0.len());
+        // SAFETY: one mark per tet slot, and searches only reach tet slots.
+        unsafe { *self.0.get_unchecked(t as usize) }
+    }
+    #[inline(always)]
+    fn set(&mut self, t: u32, m: u8) {
+        debug_assert!((t as usize) < self.0.len());
+        // SAFETY: as in `get`.
+        unsafe { *self.0.get_unchecked_mut(t as usize) = m }
+    }
+    #[inline(always)]
+    fn prefetch(&self, t: u32) {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: a prefetch never faults and reads nothing; the pointer arithmetic wraps.
+        unsafe {
+            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+            _mm_prefetch(
+                self.0.as_ptr().wrapping_add(t as usize) as *const i8,
+                _MM_HINT_T0,
+            );
+        }
     }
 }
 
@@ -138,7 +191,7 @@ pub trait CavityWatch {
 }
 
 /// The watch of a plain search.
-struct NoWatch;
+pub(super) struct NoWatch;
 
 impl CavityWatch for NoWatch {
     const WATCHES: bool = false;
@@ -264,8 +317,8 @@ impl Delaunay {
         if cavity.hint.is_some() && self.is_current(cavity) {
             let s = &mut self.scratch;
             s.kept.of = Some((cavity.p, cavity.generation));
-            s.kept.cavity.clone_from(&s.cavity);
-            s.kept.boundary.clone_from(&s.boundary);
+            s.kept.cavity.clone_from(&s.search.cavity);
+            s.kept.boundary.clone_from(&s.search.boundary);
         }
     }
 
@@ -285,7 +338,7 @@ impl Delaunay {
         if !current {
             return (&[], &[]);
         }
-        (&self.scratch.cavity, &self.scratch.boundary)
+        (&self.scratch.search.cavity, &self.scratch.search.boundary)
     }
 
     /// Inserts the probed point, with its cavity when the token is current, else (the
@@ -299,8 +352,8 @@ impl Delaunay {
             {
                 return self.insert(cavity.p, cavity.hint);
             }
-            std::mem::swap(&mut s.cavity, &mut s.kept.cavity);
-            std::mem::swap(&mut s.boundary, &mut s.kept.boundary);
+            std::mem::swap(&mut s.search.cavity, &mut s.kept.cavity);
+            std::mem::swap(&mut s.search.boundary, &mut s.kept.boundary);
             s.kept.of = None;
             // The walk a fresh search would take, for the walks' random choices that follow
             // (it is short: the probe's hint is near p).
@@ -316,7 +369,7 @@ impl Delaunay {
         Ok(Inserted::New(id))
     }
 
-    fn coincident_vertex(&self, t: u32, p: DVec3) -> Option<u32> {
+    pub(super) fn coincident_vertex(&self, t: u32, p: DVec3) -> Option<u32> {
         self.tets[t as usize]
             .v
             .iter()
@@ -358,15 +411,8 @@ impl Delaunay {
         insphere_tie(q, v.map(|i| self.rank[i as usize]), p, rank)
     }
 
-    /// Grows the cavity of `p` from `start` (which must conflict) into the scratch buffers.
-    ///
-    /// Breadth-first, with the cavity list as the queue: when a tet joins the cavity its
-    /// neighbours' records and marks are prefetched, and they are usually in cache by the time
-    /// it is dequeued and they are tested.
-    ///
-    /// `watch` sees the boundary faces in batches of its `BATCH` as they are found (a face
-    /// found is final: the tet behind it stays outside) and the rest at the end; when it
-    /// returns false the search stops, and false is returned.
+    /// Grows the cavity of `p` from `start` (which must conflict) into the scratch buffers,
+    /// marking with the triangulation's own mark array (see [`Self::search_cavity`]).
     fn find_cavity<W: CavityWatch>(
         &mut self,
         p: DVec3,
@@ -375,11 +421,46 @@ impl Delaunay {
         watch: &mut W,
     ) -> bool {
         let mut s = std::mem::take(&mut self.scratch);
+        let mut mark = std::mem::take(&mut self.mark);
         s.probed = None;
+        let found = self.search_cavity(
+            &mut ArrayMarks(&mut mark),
+            &mut s.search,
+            p,
+            rank,
+            start,
+            watch,
+        );
+        self.mark = mark;
+        self.scratch = s;
+        found
+    }
+
+    /// Grows the cavity of `p` (perturbation rank `rank`) from `start` (which must conflict)
+    /// into `s`, recording visits in `marks` (zero for every tet before and after). Reads the
+    /// triangulation only, so several searches may run at once with their own buffers and
+    /// marks (`shared.rs`).
+    ///
+    /// Breadth-first, with the cavity list as the queue: when a tet joins the cavity its
+    /// neighbours' records and marks are prefetched, and they are usually in cache by the time
+    /// it is dequeued and they are tested.
+    ///
+    /// `watch` sees the boundary faces in batches of its `BATCH` as they are found (a face
+    /// found is final: the tet behind it stays outside) and the rest at the end; when it
+    /// returns false the search stops, and false is returned.
+    pub(super) fn search_cavity<W: CavityWatch, M: Marks>(
+        &self,
+        marks: &mut M,
+        s: &mut SearchBuffers,
+        p: DVec3,
+        rank: u32,
+        start: u32,
+        watch: &mut W,
+    ) -> bool {
         s.cavity.clear();
         s.entry.clear();
         s.boundary.clear();
-        self.mark[start as usize] = INSIDE;
+        marks.set(start, INSIDE);
         s.cavity.push(start);
         s.entry.push(4);
         let mut head = 0;
@@ -404,19 +485,19 @@ impl Delaunay {
                 // A hull tet: the general test for each neighbour.
                 for (i, &r) in nb.iter().enumerate() {
                     let n = r >> 2;
-                    let m = *self.mark_ref(n);
+                    let m = marks.get(n);
                     if m == INSIDE {
                         continue;
                     }
                     if m != OUTSIDE {
                         if self.in_conflict(n, p, rank) {
-                            *self.mark_mut(n) = INSIDE;
+                            marks.set(n, INSIDE);
                             s.cavity.push(n);
                             s.entry.push((r & 3) as u8);
-                            self.prefetch_neighbors(n);
+                            self.prefetch_neighbors(n, marks);
                             continue;
                         }
-                        *self.mark_mut(n) = OUTSIDE;
+                        marks.set(n, OUTSIDE);
                     }
                     s.boundary.push(BoundaryFace {
                         v: FACE[i].map(|k| v[k]),
@@ -449,7 +530,7 @@ impl Delaunay {
                 for (&a, &i) in apex.iter().zip(&faces) {
                     // SAFETY: 4 slots of each were reserved for this tet; 3 calls push at
                     // most one each.
-                    unsafe { self.test_face(&mut s, &fan, t, v, i, nb[i], a, p, rank) };
+                    unsafe { self.test_face(marks, s, &fan, t, v, i, nb[i], a, p, rank) };
                 }
             } else {
                 // The start tet: all four faces.
@@ -458,7 +539,7 @@ impl Delaunay {
                     let a = self.tet_ref(r >> 2).v[(r & 3) as usize];
                     // SAFETY: 4 slots of each were reserved for this tet; 4 calls push at
                     // most one each.
-                    unsafe { self.test_face(&mut s, &fan, t, v, i, r, a, p, rank) };
+                    unsafe { self.test_face(marks, s, &fan, t, v, i, r, a, p, rank) };
                 }
             }
         }
@@ -468,16 +549,15 @@ impl Delaunay {
         // Leave every mark at zero for the next search (a stopped one marked only tets in
         // these lists too).
         for &t in &s.cavity {
-            *self.mark_mut(t) = 0;
+            marks.set(t, 0);
         }
         for f in &s.boundary {
-            *self.mark_mut(f.outer >> 2) = 0;
+            marks.set(f.outer >> 2, 0);
         }
         if stopped {
             s.cavity.clear();
             s.boundary.clear();
         }
-        self.scratch = s;
         !stopped
     }
 
@@ -490,9 +570,10 @@ impl Delaunay {
     /// element (the pushes are unchecked).
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    unsafe fn test_face(
-        &mut self,
-        s: &mut Scratch,
+    unsafe fn test_face<M: Marks>(
+        &self,
+        marks: &mut M,
+        s: &mut SearchBuffers,
         fan: &InsphereFan,
         t: u32,
         v: [u32; 4],
@@ -503,7 +584,7 @@ impl Delaunay {
         rank: u32,
     ) {
         let n = r >> 2;
-        let m = *self.mark_ref(n);
+        let m = marks.get(n);
         let f = FACE[i];
         let (inside, boundary) = if m == 0 {
             let conflict = if apex == INFINITE {
@@ -514,8 +595,8 @@ impl Delaunay {
                     None => self.finite_in_conflict(n, p, rank),
                 }
             };
-            *self.mark_mut(n) = OUTSIDE - conflict as u8;
-            self.prefetch_neighbors(n);
+            marks.set(n, OUTSIDE - conflict as u8);
+            self.prefetch_neighbors(n, marks);
             (conflict, !conflict)
         } else {
             (false, m == OUTSIDE)
@@ -557,16 +638,19 @@ impl Delaunay {
 
     /// Hints the records and marks of `t`'s neighbours into the cache.
     #[inline(always)]
-    fn prefetch_neighbors(&self, t: u32) {
+    fn prefetch_neighbors<M: Marks>(&self, t: u32, marks: &M) {
         #[cfg(target_arch = "x86_64")]
         // SAFETY: a prefetch never faults and reads nothing; the pointer arithmetic wraps, so
         // it is defined for any neighbour reference. SSE is baseline on x86_64.
         unsafe {
             use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
             for r in self.tet_ref(t).n {
-                let n = (r >> 2) as usize;
-                _mm_prefetch(self.tets.as_ptr().wrapping_add(n) as *const i8, _MM_HINT_T0);
-                _mm_prefetch(self.mark.as_ptr().wrapping_add(n) as *const i8, _MM_HINT_T0);
+                let n = r >> 2;
+                _mm_prefetch(
+                    self.tets.as_ptr().wrapping_add(n as usize) as *const i8,
+                    _MM_HINT_T0,
+                );
+                marks.prefetch(n);
             }
         }
     }
@@ -576,25 +660,31 @@ impl Delaunay {
     /// The new tets reuse the cavity's slots first (then the free list, then fresh slots);
     /// their mutual links are found by pairing each directed boundary edge with its reverse
     /// in a small open-addressing table.
-    fn fill_cavity(&mut self, id: u32) {
+    pub(super) fn fill_cavity(&mut self, id: u32) {
         let mut s = std::mem::take(&mut self.scratch);
         s.probed = None;
         self.generation += 1;
         // Remember the deleted tets (refinement re-checks the boundary elements they held).
         s.removed.clear();
-        for &t in &s.cavity {
+        for &t in &s.search.cavity {
             s.removed.push(self.tet_ref(t).v);
         }
-        s.removed_ids.clone_from(&s.cavity);
+        s.removed_ids.clone_from(&s.search.cavity);
+        if let Some(log) = &mut self.removals {
+            for &t in &s.search.cavity {
+                log.set(t);
+            }
+        }
         let removed_ghosts = s
+            .search
             .cavity
             .iter()
             .filter(|&&t| has_infinite(self.tet_ref(t).v))
             .count();
         // Slots: the cavity's first, then the free list, then new ones.
-        let (nf, nc) = (s.boundary.len(), s.cavity.len());
+        let (nf, nc) = (s.search.boundary.len(), s.search.cavity.len());
         s.created.clear();
-        s.created.extend_from_slice(&s.cavity[..nf.min(nc)]);
+        s.created.extend_from_slice(&s.search.cavity[..nf.min(nc)]);
         for _ in nc..nf {
             let t = match self.free.pop() {
                 Some(t) => t,
@@ -613,16 +703,20 @@ impl Delaunay {
         // Tags of the owners, read before their slots are overwritten.
         if self.tags_enabled {
             s.tags.clear();
-            s.tags
-                .extend(s.boundary.iter().map(|f| self.tags[f.owner as usize]));
+            s.tags.extend(
+                s.search
+                    .boundary
+                    .iter()
+                    .map(|f| self.tags[f.owner as usize]),
+            );
         }
-        for &t in s.cavity.iter().skip(nf) {
+        for &t in s.search.cavity.iter().skip(nf) {
             self.tet_mut(t).v = [DEAD; 4];
             self.free.push(t);
         }
         s.edges.begin(nf);
         let mut new_ghosts = 0;
-        for (k, (f, &t)) in s.boundary.iter().zip(&s.created).enumerate() {
+        for (k, (f, &t)) in s.search.boundary.iter().zip(&s.created).enumerate() {
             let face = f.v;
             *self.tet_mut(t) = Tet {
                 v: [face[0], face[1], face[2], id],
@@ -650,7 +744,7 @@ impl Delaunay {
         }
         // The neighbouring boundary face runs along each edge the other way. Each side writes
         // its own link.
-        for (f, &t) in s.boundary.iter().zip(&s.created) {
+        for (f, &t) in s.search.boundary.iter().zip(&s.created) {
             let face = f.v;
             for j in 0..3 {
                 let other = s.edges.get(face[(j + 2) % 3], face[(j + 1) % 3]);

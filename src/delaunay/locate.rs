@@ -11,6 +11,15 @@ impl Delaunay {
     /// Returns a finite tet whose closure contains `p`, or a hull tet whose hull face has `p`
     /// strictly outside it.
     pub(super) fn locate(&mut self, p: DVec3, start: u32) -> u32 {
+        let mut rng = self.rng;
+        let t = self.walk(p, start, &mut rng);
+        self.rng = rng;
+        t
+    }
+
+    /// [`Self::locate`] with the walk's random choices drawn from `rng` (xorshift state,
+    /// nonzero): reads the triangulation only.
+    pub(super) fn walk(&self, p: DVec3, start: u32, rng: &mut u32) -> u32 {
         let mut t = start;
         if let Some(k) = self.infinite_index(t) {
             t = self.tets[t as usize].n[k] >> 2;
@@ -18,7 +27,7 @@ impl Delaunay {
         let mut came_from = u32::MAX;
         'walk: loop {
             let v = self.tets[t as usize].v;
-            let r = self.next_random() as usize;
+            let r = super::xorshift(rng) as usize;
             for k in 0..4 {
                 let i = (r + k) & 3;
                 let n = self.tets[t as usize].n[i] >> 2;

@@ -16,6 +16,7 @@ mod cavity;
 pub mod hilbert;
 mod locate;
 mod parallel;
+mod shared;
 pub mod tables;
 mod validate;
 
@@ -23,6 +24,7 @@ use crate::geom::{self, orient3d};
 pub use cavity::{BoundaryFace, Cavity, CavityWatch, DryRun, Probe};
 use glam::DVec3;
 pub use parallel::{resolve_threads, ParallelReport, MAX_THREADS};
+pub use shared::{OwnedCavity, ProbeBuffers, SharedProbe};
 use tables::FACE;
 
 /// Id of the vertex at infinity (hull tets carry it).
@@ -120,6 +122,8 @@ pub struct Delaunay {
     /// from an earlier generation is stale.
     generation: u64,
     scratch: cavity::Scratch,
+    /// The tet slots removed since [`Self::track_removals`] (None: not tracking).
+    removals: Option<shared::RemovalLog>,
 }
 
 impl Delaunay {
@@ -289,6 +293,7 @@ impl Delaunay {
             + self.mark.capacity()
             + self.free.capacity() * 4
             + self.scratch.memory_bytes()
+            + self.removals.as_ref().map_or(0, |log| log.memory_bytes())
     }
 
     /// Turns on per-tet tags (all zero now); new tets inherit the tag of the cavity tet they
@@ -513,18 +518,6 @@ impl Delaunay {
         // SAFETY: see the invariants above.
         unsafe { self.tets.get_unchecked_mut(t as usize) }
     }
-    #[inline(always)]
-    fn mark_ref(&self, t: u32) -> &u8 {
-        debug_assert!((t as usize) < self.mark.len());
-        // SAFETY: `mark` has one entry per tet slot.
-        unsafe { self.mark.get_unchecked(t as usize) }
-    }
-    #[inline(always)]
-    fn mark_mut(&mut self, t: u32) -> &mut u8 {
-        debug_assert!((t as usize) < self.mark.len());
-        // SAFETY: `mark` has one entry per tet slot.
-        unsafe { self.mark.get_unchecked_mut(t as usize) }
-    }
     /// Coordinates of a finite vertex of an alive tet.
     #[inline(always)]
     fn point_ref(&self, v: u32) -> DVec3 {
@@ -578,17 +571,15 @@ impl Delaunay {
             (self.tets.len() - 1) as u32
         }
     }
+}
 
-    /// Cheap xorshift for the walk's random first face.
-    #[inline]
-    fn next_random(&mut self) -> u32 {
-        let mut x = self.rng;
-        x ^= x << 13;
-        x ^= x >> 17;
-        x ^= x << 5;
-        self.rng = x;
-        x
-    }
+/// The next value of xorshift32 state `x` (nonzero), the walks' random choices.
+#[inline(always)]
+fn xorshift(x: &mut u32) -> u32 {
+    *x ^= *x << 13;
+    *x ^= *x >> 17;
+    *x ^= *x << 5;
+    *x
 }
 
 /// A set of tet ids for walking a vertex star: open addressing in a fixed table on the stack
