@@ -168,7 +168,9 @@ fn deterministic() {
 /// reaches today; the floors are above tetgen -pq1.414 at a similar tet count on rotor, spool,
 /// elephant, part, the ceilings below its maxima on all but anchor; before the improver's
 /// vertex insertion and the refinement's refusal to split flat tets, rotor, spool and anchor
-/// ended at 0.00 degrees).
+/// ended at 0.00 degrees). The smallest angle next to acute input angles depends on the random
+/// draws: rotor and joint below their lowest over seeds 1-4 (rotor 5.71-9.59 degrees, joint
+/// 7.71-14.33; tetgen -pq1.414: 0.64 and 6.57).
 fn acute(rel: &str, floor_deg: f64, ceiling_deg: f64) {
     let (m, r) = mesh(rel, true);
     check_kept(rel, &m);
@@ -186,7 +188,7 @@ fn acute(rel: &str, floor_deg: f64, ceiling_deg: f64) {
 
 #[test]
 fn acute_rotor() {
-    acute("off/rotor.off", 6.5, 170.0);
+    acute("off/rotor.off", 5.5, 170.0);
 }
 #[test]
 fn acute_part() {
@@ -195,7 +197,7 @@ fn acute_part() {
 #[test]
 fn acute_fandisk_joint() {
     acute("off/fandisk.off", 17.0, 160.0);
-    acute("off/joint.off", 9.0, 165.0);
+    acute("off/joint.off", 7.5, 165.0);
 }
 #[test]
 fn acute_others() {

@@ -83,6 +83,9 @@ pub(super) trait Marks {
     fn set(&mut self, t: u32, m: u8);
     /// Hints tet `t`'s mark into the cache.
     fn prefetch(&self, t: u32);
+    /// Sets every mark back to zero after a search that visited the tets of `cavity` and
+    /// those across `boundary` (a stopped one marked only tets in these lists too).
+    fn clear(&mut self, cavity: &[u32], boundary: &[BoundaryFace]);
 }
 
 /// The triangulation's one-byte mark per tet slot.
@@ -111,6 +114,15 @@ impl Marks for ArrayMarks<'_> {
                 self.0.as_ptr().wrapping_add(t as usize) as *const i8,
                 _MM_HINT_T0,
             );
+        }
+    }
+    #[inline]
+    fn clear(&mut self, cavity: &[u32], boundary: &[BoundaryFace]) {
+        for &t in cavity {
+            self.set(t, 0);
+        }
+        for f in boundary {
+            self.set(f.outer >> 2, 0);
         }
     }
 }
@@ -190,8 +202,8 @@ pub trait CavityWatch {
     fn faces(&mut self, faces: &[BoundaryFace], points: &[DVec3]) -> bool;
 }
 
-/// The watch of a plain search.
-pub(super) struct NoWatch;
+/// The watch of a plain search: sees nothing, never stops it.
+pub struct NoWatch;
 
 impl CavityWatch for NoWatch {
     const WATCHES: bool = false;
@@ -546,14 +558,7 @@ impl Delaunay {
         if W::WATCHES && !stopped {
             stopped = !watch.faces(&s.boundary[watched..], &self.points);
         }
-        // Leave every mark at zero for the next search (a stopped one marked only tets in
-        // these lists too).
-        for &t in &s.cavity {
-            marks.set(t, 0);
-        }
-        for f in &s.boundary {
-            marks.set(f.outer >> 2, 0);
-        }
+        marks.clear(&s.cavity, &s.boundary);
         if stopped {
             s.cavity.clear();
             s.boundary.clear();

@@ -21,7 +21,7 @@ pub mod tables;
 mod validate;
 
 use crate::geom::{self, orient3d};
-pub use cavity::{BoundaryFace, Cavity, CavityWatch, DryRun, Probe};
+pub use cavity::{BoundaryFace, Cavity, CavityWatch, DryRun, NoWatch, Probe};
 use glam::DVec3;
 pub use parallel::{resolve_threads, ParallelReport, MAX_THREADS};
 pub use shared::{OwnedCavity, ProbeBuffers, SharedProbe};

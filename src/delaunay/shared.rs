@@ -187,6 +187,9 @@ struct MarkTable {
     generation: u32,
     len: usize,
     shift: u32,
+    /// The tet the last `get` looked up and the slot it found (a search reads a tet's mark,
+    /// then sets it).
+    last: std::cell::Cell<(u32, usize)>,
 }
 
 #[derive(Debug, Clone, Copy, Default)]
@@ -201,6 +204,7 @@ impl MarkTable {
 
     /// Empties the table for a new search.
     fn begin(&mut self) {
+        self.last.set((u32::MAX, 0));
         if self.slots.is_empty() {
             self.resize(Self::MIN_SLOTS);
         }
@@ -213,6 +217,7 @@ impl MarkTable {
     }
 
     fn resize(&mut self, n: usize) {
+        self.last.set((u32::MAX, 0));
         let old = std::mem::replace(&mut self.slots, vec![MarkSlot::default(); n]);
         let generation = self.generation;
         self.shift = 32 - n.trailing_zeros();
@@ -246,7 +251,9 @@ impl MarkTable {
 impl Marks for MarkTable {
     #[inline]
     fn get(&self, t: u32) -> u8 {
-        let s = &self.slots[self.find(t)];
+        let i = self.find(t);
+        self.last.set((t, i));
+        let s = &self.slots[i];
         if s.stamp == self.generation {
             s.mark
         } else {
@@ -256,7 +263,11 @@ impl Marks for MarkTable {
 
     #[inline]
     fn set(&mut self, t: u32, m: u8) {
-        let i = self.find(t);
+        // Usually the slot `get` just found for `t` (its own, or the empty one for it).
+        let i = match self.last.replace((u32::MAX, 0)) {
+            (tet, i) if tet == t => i,
+            _ => self.find(t),
+        };
         if self.slots[i].stamp != self.generation {
             if 2 * (self.len + 1) > self.slots.len() {
                 self.resize(2 * self.slots.len());
@@ -273,6 +284,10 @@ impl Marks for MarkTable {
 
     #[inline(always)]
     fn prefetch(&self, _t: u32) {}
+
+    /// Nothing to do: the next search starts a new generation.
+    #[inline]
+    fn clear(&mut self, _cavity: &[u32], _boundary: &[BoundaryFace]) {}
 }
 
 #[cfg(test)]

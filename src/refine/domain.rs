@@ -3,7 +3,7 @@
 //! lies on.
 
 use crate::cdt::{Change, FacetMesh};
-use crate::delaunay::{Cavity, Delaunay, Inserted};
+use crate::delaunay::{Cavity, Delaunay, DelaunayError, Inserted, OwnedCavity};
 use crate::plc::{Plc, PlcInput};
 use crate::run::error::MeshError;
 use glam::DVec3;
@@ -346,6 +346,28 @@ impl Domain {
             Some(c) if c.point() == p && self.dt.is_current(&c) => self.dt.insert_cavity(c),
             _ => self.dt.insert(p, hint),
         };
+        self.record_insertion(p, kind, inserted)
+    }
+
+    /// Inserts a new vertex at `cavity`'s point with that cavity, which must be intact
+    /// (`OwnedCavity::intact`: the caller checks).
+    pub fn insert_point_owned(
+        &mut self,
+        cavity: &OwnedCavity,
+        kind: VertexKind,
+    ) -> Result<u32, MeshError> {
+        let inserted = self.dt.insert_owned(cavity);
+        self.record_insertion(cavity.point(), kind, inserted)
+    }
+
+    /// The books of an insertion of `p` as a `kind` vertex: its kind, protecting apex and
+    /// small-angle status, the boundary elements around it queued, its tets logged.
+    fn record_insertion(
+        &mut self,
+        p: DVec3,
+        kind: VertexKind,
+        inserted: Result<Inserted, DelaunayError>,
+    ) -> Result<u32, MeshError> {
         match inserted {
             Ok(Inserted::New(id)) => {
                 let apex = self.apex_of(p, kind);

@@ -8,10 +8,10 @@
 //! subfacet queues) is `recover.rs`.
 
 use super::domain::{seg_key, tri_key, Domain, VertexKind};
-use super::levels::{try_candidate, Conflict, FacetLevel, Picker, Request};
+use super::levels::{try_candidate, Conflict, FacetLevel, LevelProbe, Picker, Request};
 use super::outcome::{BoundaryKind, Outcome, Refusal};
 use super::recover::{Settled, MAX_RECOVERY_SPLITS};
-use crate::delaunay::{tables::FACE, Cavity, Delaunay, INFINITE};
+use crate::delaunay::{tables::FACE, BoundaryFace, Cavity, Delaunay, OwnedCavity, INFINITE};
 use crate::geom::{diametric_ball, equatorial_ball, tri_circumcenter};
 use crate::run::error::MeshError;
 use glam::DVec3;
@@ -76,9 +76,33 @@ impl Domain {
     /// inner side does not have p in its circumsphere); of the encroached elements it names
     /// the smallest subsegment (by key), else the smallest subfacet.
     fn boundary_in_cavity(&self, cavity: &Cavity) -> Option<Boundary> {
+        let (removed, faces) = self.dt.cavity(cavity);
+        self.boundary_in(cavity.point(), removed, faces)
+    }
+
+    /// [`Self::boundary_in_cavity`] of a cavity probed through a shared reference.
+    pub(super) fn boundary_in_owned(&self, cavity: &OwnedCavity) -> Option<Boundary> {
+        self.boundary_in(cavity.point(), cavity.tets(), cavity.boundary())
+    }
+
+    /// The conflict test of a cell's point with its cavity probed through a shared reference
+    /// (as `FacetLevel::conflict`).
+    pub(super) fn conflict_owned(
+        &self,
+        cavity: &OwnedCavity,
+        r: f64,
+        request: Request,
+    ) -> Conflict<Boundary> {
+        match self.boundary_in_owned(cavity) {
+            None => Conflict::Free,
+            Some(b) => self.judge(b, r, request),
+        }
+    }
+
+    /// The boundary element whose protection inserting `p` would violate, its cavity being the
+    /// tets `removed` with boundary `faces` (see [`Self::boundary_in_cavity`]).
+    fn boundary_in(&self, p: DVec3, removed: &[u32], faces: &[BoundaryFace]) -> Option<Boundary> {
         let dom = self;
-        let p = cavity.point();
-        let (removed, faces) = dom.dt.cavity(cavity);
         // Every vertex of a cavity tet is on the cavity's boundary, and a ring tet adds one
         // vertex to a boundary face: if no boundary face has a vertex on the domain boundary,
         // no cavity or ring tet has two, so the scan below would find no subsegment or
@@ -256,7 +280,15 @@ impl Domain {
         // The centre first (it passed the facet checks above), then random draws.
         let mut best = None;
         let hint = self.dt.vertex_tet(t[0]);
-        let centre_ok = try_candidate(self, picker, cf, rf, hint, false, &mut best);
+        let centre_ok = try_candidate(
+            &mut LevelProbe(self),
+            picker,
+            cf,
+            rf,
+            hint,
+            false,
+            &mut best,
+        );
         let tries = if centre_ok { 0 } else { picker.max_tries };
         for _ in 0..tries {
             let (s, th) = (
@@ -271,7 +303,7 @@ impl Domain {
                 continue;
             }
             let hint = self.dt.vertex_tet(t[0]);
-            if try_candidate(self, picker, p, rf, hint, false, &mut best) {
+            if try_candidate(&mut LevelProbe(self), picker, p, rf, hint, false, &mut best) {
                 break;
             }
         }
@@ -303,7 +335,7 @@ impl Domain {
                 let t = 0.5 + picker.rng.gen_range(-0.5..0.5) * picker.delta;
                 let p = pa + (pc - pa) * t;
                 let hint = self.dt.vertex_tet(a);
-                if try_candidate(self, picker, p, r, hint, false, &mut best) {
+                if try_candidate(&mut LevelProbe(self), picker, p, r, hint, false, &mut best) {
                     break;
                 }
             }

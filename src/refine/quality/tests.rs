@@ -1,6 +1,8 @@
 //! Tests of the quality refinement's decisions and books.
 
 use super::*;
+use crate::delaunay::Probe;
+use crate::refine::levels::Request;
 use crate::refine::queue::book;
 
 /// The unit cube meshed to a conforming boundary and marked: its domain and regions.
@@ -65,7 +67,7 @@ fn encroached_element_gone_after_resettling_is_not_split() {
     // smaller than the tet), the boundary is restored, and nothing else is split.
     let (mut dom, regions, t) = cube_with_unsettled_subsegment();
     let bad = Bad {
-        class: RATIO,
+        class: Class::Ratio,
         tet: t,
         verts: dom.dt.tet(t),
     };
@@ -96,7 +98,7 @@ fn refusals_are_counted_and_cascades_remembered() {
     let seg = *dom.subsegs.keys().min().unwrap();
     let rb = 0.5 * dom.point(seg.0).distance(dom.point(seg.1));
     let bad = Bad {
-        class: RATIO,
+        class: Class::Ratio,
         tet: t,
         verts: dom.dt.tet(t),
     };
@@ -112,12 +114,10 @@ fn refusals_are_counted_and_cascades_remembered() {
     let outcome = refiner.yield_to_boundary(t, conflict).unwrap().unwrap();
     assert_eq!(outcome, Outcome::Refused(Refusal::Cascade));
     assert!(book(&mut refiner, bad, outcome, n).unwrap());
-    let again = refiner.refine_tet(bad, true).unwrap();
+    let again = refiner.refine(bad, false).unwrap();
     assert_eq!(again, Outcome::Refused(Refusal::Futile));
     assert!(book(&mut refiner, bad, again, n).unwrap());
-    let on_vertex = refiner.dom.point(0);
-    let duplicate = refiner.insert_volume_point(on_vertex, 1.0, t).unwrap();
-    assert_eq!(duplicate, Outcome::Refused(Refusal::Duplicate));
+    let duplicate = Outcome::Refused(Refusal::Duplicate);
     assert!(book(&mut refiner, bad, duplicate, n).unwrap());
     assert_eq!(refiner.dom.dt.num_vertices(), n);
     let r = &refiner.refusals;
@@ -235,7 +235,14 @@ fn plc_facet_level_conflicts_follow_the_request() {
     );
     let inside_cavity = probe(&mut dom, inside);
     let t = dom.dt.locate_point(inside, None);
-    let chosen = pick_in_ball(&mut dom, &mut picker, inside, Some(inside_cavity), 0.2, t);
+    let chosen = pick_in_ball(
+        &mut super::super::levels::LevelProbe(&mut dom),
+        &mut picker,
+        inside,
+        Some(inside_cavity),
+        0.2,
+        t,
+    );
     let chosen = chosen.expect("a point that breaks nothing");
     assert!(chosen.point().distance(inside) <= params.delta * 0.2);
     assert!(dom.encroached(&chosen).is_none());
