@@ -83,6 +83,9 @@ pub struct Refiner<'a> {
     probe_buf: ProbeBuffers,
     /// Where the tets logged since the last step begin (`push_recent` gives them regions).
     retag_from: usize,
+    /// Batches chosen so far, and per vertex the last batch that claimed it (`select`).
+    batches: u32,
+    claims: Vec<u32>,
     /// An error met where it could not be returned (classifying when a budget stops the
     /// loop); `run` returns it.
     failed: Option<MeshError>,
@@ -138,6 +141,8 @@ impl<'a> Refiner<'a> {
             batch: Batch::default(),
             probe_buf: ProbeBuffers::default(),
             retag_from: 0,
+            batches: 0,
+            claims: Vec::new(),
             failed: None,
         }
     }
@@ -461,8 +466,12 @@ impl PlannedLevel for Refiner<'_> {
 
     fn select(&mut self, window: Taken<Bad>, size: usize) -> (Taken<Bad>, Taken<Bad>) {
         // Tets sharing a vertex with a chosen tet or its neighbours are left for a later
-        // batch: their cavities would likely meet.
-        let mut claimed: FxHashSet<u32> = FxHashSet::default();
+        // batch: their cavities would likely meet. A vertex is claimed by this batch when its
+        // stamp is the batch's number.
+        self.batches += 1;
+        let batch = self.batches;
+        let mut claims = std::mem::take(&mut self.claims);
+        claims.resize(self.dom.dt.num_vertex_ids(), 0);
         let (mut chosen, mut rest) = (Vec::with_capacity(size), Vec::new());
         for (bad, source) in window {
             if !self.is_current(bad) {
@@ -475,14 +484,17 @@ impl PlannedLevel for Refiner<'_> {
                 let (n, j) = dt.mirror(bad.tet, i);
                 *apex = dt.tet(n)[j];
             }
-            let free = |v: &u32| *v == INFINITE || !claimed.contains(v);
+            let free = |v: &u32| *v == INFINITE || claims[*v as usize] != batch;
             if chosen.len() < size && near.iter().all(free) {
-                claimed.extend(near.into_iter().filter(|&v| v != INFINITE));
+                for v in near.into_iter().filter(|&v| v != INFINITE) {
+                    claims[v as usize] = batch;
+                }
                 chosen.push((bad, source));
             } else {
                 rest.push((bad, source));
             }
         }
+        self.claims = claims;
         (chosen, rest)
     }
 
