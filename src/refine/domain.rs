@@ -2,6 +2,7 @@
 //! the subsegments and each facet's 2D triangulation (its subfacets), and what every vertex
 //! lies on.
 
+use super::plc_level::FacetSplitCache;
 use crate::cdt::{Change, FacetMesh};
 use crate::delaunay::{Cavity, Delaunay, DelaunayError, Inserted, OwnedCavity};
 use crate::plc::{Plc, PlcInput};
@@ -70,6 +71,9 @@ pub struct Domain {
     /// Whether a boundary vertex (segment or facet) was inserted since the refiner last looked:
     /// only then can a cavity have crossed a subfacet (`retag_created`).
     pub boundary_inserted: bool,
+    /// Per facet, what splitting its subfacets reads (built when first needed, then kept up
+    /// to date by the splits).
+    pub(super) split_caches: Vec<Option<FacetSplitCache>>,
 }
 
 /// Input angles below this (between segments at a vertex, or between facets at a segment) are
@@ -162,6 +166,7 @@ impl Domain {
             dirty_tris: vec![],
             created_log: vec![],
             boundary_inserted: false,
+            split_caches: Vec::new(),
         })
     }
 
@@ -449,6 +454,10 @@ impl Domain {
                 .split_edge(a, b, id, p)
                 .map_err(|e| MeshError::Internal(format!("facet {f}: {e}")))?;
             self.apply_change(f, &change);
+            let (pa, pb) = (self.point(a), self.point(b));
+            if let Some(cache) = self.split_cache_mut(f) {
+                cache.split_subsegment((a, pa), (b, pb), (id, p));
+            }
         }
         Ok(id)
     }
@@ -505,7 +514,15 @@ impl Domain {
             ))
         })?;
         self.apply_change(f, &change);
+        if let Some(cache) = self.split_cache_mut(f) {
+            cache.add_vertex(p);
+        }
         Ok(id)
+    }
+
+    /// Facet `f`'s split cache, if it was built.
+    fn split_cache_mut(&mut self, f: u32) -> Option<&mut FacetSplitCache> {
+        self.split_caches.get_mut(f as usize)?.as_mut()
     }
 }
 

@@ -258,8 +258,7 @@ impl Domain {
         // The facet's plane snap and subsegment balls, once for the centre and all the draws
         // (the same tests as snap_to_facet_plane and facet_subsegments_encroached_by, which
         // walk the whole facet).
-        let snap = PlaneSnap::of(self, f);
-        let balls = subsegment_balls(self, f);
+        let (snap, balls) = self.split_cache(f);
         let cf = snap.apply(cf);
         let enc = balls
             .iter()
@@ -316,6 +315,26 @@ impl Domain {
         Ok(Ok(BoundaryKind::Facet))
     }
 
+    /// Facet `f`'s plane snap and subsegment balls (from its split cache, built now if it was
+    /// not: walking the whole facet for every split made keep mode quadratic in a facet's
+    /// size).
+    fn split_cache(&mut self, f: u32) -> (PlaneSnap, Vec<SubsegmentBall>) {
+        if self.split_caches.len() < self.facets.len() {
+            self.split_caches.resize_with(self.facets.len(), || None);
+        }
+        if self.split_caches[f as usize].is_none() {
+            let cache = FacetSplitCache {
+                snap: PlaneSnap::of(self, f),
+                balls: subsegment_balls(self, f),
+            };
+            self.split_caches[f as usize] = Some(cache);
+        }
+        let cache = self.split_caches[f as usize]
+            .as_ref()
+            .map(|c| (c.snap, c.balls.clone()));
+        cache.unwrap_or_else(|| (PlaneSnap::of(self, f), subsegment_balls(self, f)))
+    }
+
     /// Splits subsegment ac from its picking interval (midpoint +- delta/2 of its length), or at
     /// the concentric-shell point next to an acute input vertex.
     fn split_segment_picked(
@@ -349,8 +368,37 @@ impl Domain {
     }
 }
 
+/// What splitting a facet's subfacets reads of the whole facet: its plane snap and its
+/// subsegments' balls. Kept equal to what walking the facet would give: a vertex added to the
+/// facet can only unset shared coordinates, and a subsegment split replaces one ball by two.
+pub(super) struct FacetSplitCache {
+    snap: PlaneSnap,
+    balls: Vec<SubsegmentBall>,
+}
+
+impl FacetSplitCache {
+    /// Vertex `p` was inserted into the facet.
+    pub(super) fn add_vertex(&mut self, p: DVec3) {
+        self.snap.add(p);
+    }
+
+    /// Subsegment ab of the facet was split at vertex `m` (each with its point).
+    pub(super) fn split_subsegment(
+        &mut self,
+        (a, pa): (u32, DVec3),
+        (b, pb): (u32, DVec3),
+        (m, pm): (u32, DVec3),
+    ) {
+        self.snap.add(pm);
+        self.balls.retain(|ball| ball.key != seg_key(a, b));
+        self.balls.push(SubsegmentBall::of(a, pa, m, pm));
+        self.balls.push(SubsegmentBall::of(m, pm, b, pb));
+    }
+}
+
 /// [`Domain::snap_to_facet_plane`] for one facet, its vertices looked at once: the
 /// coordinates shared by all of them.
+#[derive(Clone, Copy)]
 struct PlaneSnap([Option<f64>; 3]);
 
 impl PlaneSnap {
@@ -372,6 +420,15 @@ impl PlaneSnap {
         PlaneSnap(axes)
     }
 
+    /// Point `q` joined the facet's vertices.
+    fn add(&mut self, q: DVec3) {
+        for (axis, a) in self.0.iter_mut().enumerate() {
+            if a.is_some_and(|c| q[axis] != c) {
+                *a = None;
+            }
+        }
+    }
+
     fn apply(&self, mut p: DVec3) -> DVec3 {
         for (axis, a) in self.0.iter().enumerate() {
             if let Some(c) = a {
@@ -384,10 +441,22 @@ impl PlaneSnap {
 
 /// A subsegment's closed diametric ball, slightly inflated, as
 /// [`Domain::facet_subsegments_encroached_by`] tests it.
+#[derive(Clone, Copy)]
 struct SubsegmentBall {
     key: (u32, u32),
     centre: DVec3,
     r2: f64,
+}
+
+impl SubsegmentBall {
+    fn of(x: u32, px: DVec3, y: u32, py: DVec3) -> SubsegmentBall {
+        let (centre, r) = diametric_ball(px, py);
+        SubsegmentBall {
+            key: seg_key(x, y),
+            centre,
+            r2: r * r * (1.0 + 1e-9),
+        }
+    }
 }
 
 /// The balls of facet `f`'s subsegments.
@@ -395,14 +464,7 @@ fn subsegment_balls(dom: &Domain, f: u32) -> Vec<SubsegmentBall> {
     dom.facets[f as usize]
         .constrained_edges()
         .into_iter()
-        .map(|[x, y]| {
-            let (centre, r) = diametric_ball(dom.point(x), dom.point(y));
-            SubsegmentBall {
-                key: seg_key(x, y),
-                centre,
-                r2: r * r * (1.0 + 1e-9),
-            }
-        })
+        .map(|[x, y]| SubsegmentBall::of(x, dom.point(x), y, dom.point(y)))
         .collect()
 }
 
