@@ -14,7 +14,7 @@
 use super::domain::Domain;
 use super::levels::{pick_in_ball, Conflict, Picker, Probing, Request, Score};
 use super::outcome::Refusal;
-use super::plc_level::Boundary;
+use super::plc_level::{Boundary, SplitPlan};
 use super::quality::{Bad, BoundingBox};
 use super::queue::Class;
 use crate::delaunay::{CavityWatch, NoWatch, OwnedCavity, ProbeBuffers, SharedProbe};
@@ -38,11 +38,12 @@ pub(crate) enum Plan {
         reason: Refusal,
         located: Option<u32>,
     },
-    /// Its point (with this cavity) conflicts with the boundary: refine that first, or leave
-    /// the tet (never `Conflict::Free`).
+    /// Its point (with this cavity) conflicts with the boundary: refine that first (`split`:
+    /// planned too), or leave the tet (never `Conflict::Free`).
     Yield {
         conflict: Conflict<Boundary>,
         cavity: OwnedCavity,
+        split: Option<SplitPlan>,
     },
     /// Insert a volume vertex with this cavity.
     Insert(OwnedCavity),
@@ -106,7 +107,7 @@ impl Planner<'_> {
                 Some(SharedProbe::Cavity(cavity)) => {
                     match dom.conflict_owned(&cavity, r, Request::SizeNearSmallAngle) {
                         Conflict::Free => Plan::Insert(cavity),
-                        conflict => Plan::Yield { conflict, cavity },
+                        conflict => self.yield_plan(conflict, cavity, buf),
                     }
                 }
                 // The centroid is a vertex already (a flat tet's centroid can be).
@@ -136,7 +137,7 @@ impl Planner<'_> {
         };
         match dom.conflict_owned(&cavity, r, request) {
             Conflict::Free => {}
-            conflict => return Plan::Yield { conflict, cavity },
+            conflict => return self.yield_plan(conflict, cavity, buf),
         }
         match near {
             true => Plan::Insert(cavity),
@@ -210,6 +211,28 @@ impl Planner<'_> {
         None
     }
 
+    /// The plan of a tet whose point (with `cavity`) conflicts with the boundary: the
+    /// encroached element's split planned too.
+    fn yield_plan(
+        &self,
+        conflict: Conflict<Boundary>,
+        cavity: OwnedCavity,
+        buf: &mut ProbeBuffers,
+    ) -> Plan {
+        let split = match conflict {
+            Conflict::Encroaches(b) => {
+                let mut picker = self.picker.reseeded(split_seed(self.params.seed, b));
+                Some(self.dom.plan_split(b, &mut picker, buf))
+            }
+            _ => None,
+        };
+        Plan::Yield {
+            conflict,
+            cavity,
+            split,
+        }
+    }
+
     /// Li's choice in bad tet `bad`'s picking ball (centre `centre`, circumradius `r`, which
     /// breaks no boundary: `centre_cavity` is its probe, None if it is a vertex), drawing from
     /// a generator seeded by the run's seed and the tet.
@@ -248,11 +271,26 @@ fn tet_seed(seed: u64, verts: [u32; 4]) -> u64 {
     h
 }
 
+/// The seed of the random draws splitting boundary element `b`: the run's seed mixed with its
+/// vertices.
+pub(super) fn split_seed(seed: u64, b: Boundary) -> u64 {
+    match b {
+        Boundary::Segment(a, c) => tet_seed(seed ^ 0x5e6, [a, c, u32::MAX, u32::MAX]),
+        Boundary::Facet(_, [x, y, z]) => tet_seed(seed ^ 0xfac, [x, y, z, u32::MAX]),
+    }
+}
+
 /// Keep mode's facet level probed through a shared reference ([`Probing`]), with a plan's own
 /// buffers: the cavities come out owned.
-struct SharedProbing<'a> {
+pub(super) struct SharedProbing<'a> {
     dom: &'a Domain,
     buf: &'a mut ProbeBuffers,
+}
+
+impl<'a> SharedProbing<'a> {
+    pub(super) fn new(dom: &'a Domain, buf: &'a mut ProbeBuffers) -> Self {
+        SharedProbing { dom, buf }
+    }
 }
 
 impl Probing for SharedProbing<'_> {

@@ -15,11 +15,11 @@
 
 use super::classify::{Classifier, Step};
 use super::domain::{Domain, VertexKind};
-use super::levels::{Conflict, FacetLevel, Picker};
+use super::levels::{Conflict, Picker};
 use super::mark::Regions;
 use super::outcome::{Outcome, Refusal};
-use super::plan::{Plan, Planner};
-use super::plc_level::Boundary;
+use super::plan::{split_seed, Plan, Planner};
+use super::plc_level::{Boundary, SplitPlan};
 use super::queue::{work_off_planned, BadLevel, BadQueues, Class, Ended, PlannedLevel, Taken};
 use super::recover::Settled;
 use crate::delaunay::{ProbeBuffers, INFINITE};
@@ -250,6 +250,7 @@ impl<'a> Refiner<'a> {
     /// Runs the refinement until no bad tet is left or a budget stops it (the loop is
     /// `queue::work_off`'s, with this level's hooks).
     pub fn run(&mut self, progress: &mut dyn FnMut(usize) -> bool) -> Result<(), MeshError> {
+        self.dom.build_split_caches();
         let all: Vec<u32> = self.dom.dt.finite_tet_ids().collect();
         self.push_tets(&all)?;
         let ended = work_off_planned(self, progress)?;
@@ -309,11 +310,15 @@ impl<'a> Refiner<'a> {
             Plan::Refuse(reason) => Ok(Outcome::Refused(reason)),
             Plan::Defer => Ok(Outcome::Deferred),
             Plan::Resettle { reason, .. } => self.resettle_or_refuse(bad.tet, reason),
-            Plan::Yield { conflict, .. } => Ok(self
-                .yield_to_boundary(bad.tet, conflict)?
+            // (Never `Free`: the planner inserts then.)
+            Plan::Yield {
+                conflict, split, ..
+            } => Ok(self
+                .yield_to_boundary(bad.tet, conflict, split)?
                 .unwrap_or(Outcome::Refused(Refusal::Duplicate))),
             Plan::Insert(cavity) => {
-                self.dom.insert_point_owned(&cavity, VertexKind::Volume)?;
+                self.dom
+                    .insert_point(cavity.point(), VertexKind::Volume, None, Some(&cavity))?;
                 self.settle_and_queue(Outcome::Inserted)
             }
             Plan::InsertAt(p) => self.insert_volume_vertex(p, bad.tet),
@@ -343,8 +348,24 @@ impl<'a> Refiner<'a> {
     /// Refines boundary element `b` that a bad tet's point encroaches (the facet level splits
     /// it from its picking region and restores empty encroachment around the new vertex), then
     /// queues the new bad tets.
-    fn refine_boundary(&mut self, b: Boundary) -> Result<Outcome, MeshError> {
-        let outcome = self.dom.refine_encroached(b, &mut self.picker)?;
+    fn refine_boundary(
+        &mut self,
+        b: Boundary,
+        planned: Option<SplitPlan>,
+    ) -> Result<Outcome, MeshError> {
+        // A split planned with the batch is carried out while it holds; else planned now, by
+        // the same code with the same draws.
+        let plan = match planned {
+            Some(plan) if plan.still_valid(self.dom) => plan,
+            _ => {
+                let mut picker = self.picker.reseeded(split_seed(self.params.seed, b));
+                let mut buf = std::mem::take(&mut self.probe_buf);
+                let plan = self.dom.plan_split(b, &mut picker, &mut buf);
+                self.probe_buf = buf;
+                plan
+            }
+        };
+        let outcome = self.dom.apply_split(plan)?;
         if !matches!(outcome, Outcome::Refused(_)) {
             self.push_recent()?;
         }
@@ -358,10 +379,11 @@ impl<'a> Refiner<'a> {
         &mut self,
         t: u32,
         conflict: Conflict<Boundary>,
+        split: Option<SplitPlan>,
     ) -> Result<Option<Outcome>, MeshError> {
         Ok(Some(match conflict {
             Conflict::Free => return Ok(None),
-            Conflict::Encroaches(b) => self.refine_boundary(b)?,
+            Conflict::Encroaches(b) => self.refine_boundary(b, split)?,
             // When restoring split anything, the encroached element (and the tet) may be
             // gone: it is never split for this tet, which `run` looks at again if it
             // survived. When it split nothing, the tet is left for good.

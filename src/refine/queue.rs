@@ -64,17 +64,24 @@ impl<T> BadQueues<T> {
         self.deferred.pop_front().map(|b| (b, true))
     }
 
-    /// Takes the first `n` elements in the order [`Self::pop`] would take them, each with the
-    /// queue it came from (for [`Self::put_front`]).
+    /// Takes up to `n` elements from the front of the queue [`Self::pop`] would take from
+    /// next (one class, or the deferred queue: a batch never mixes classes, so the higher
+    /// classes are still worked off first), each with the queue it came from (for
+    /// [`Self::put_front`]).
     pub(crate) fn take_front(&mut self, n: usize) -> Vec<(T, Source)> {
-        let mut taken = Vec::with_capacity(n);
-        for (i, q) in self.queues.iter_mut().enumerate().rev() {
-            let k = (n - taken.len()).min(q.len());
-            taken.extend(q.drain(..k).map(|b| (b, Source::Class(i as u8))));
+        if let Some(i) = (0..self.queues.len())
+            .rev()
+            .find(|&i| !self.queues[i].is_empty())
+        {
+            let q = &mut self.queues[i];
+            let k = n.min(q.len());
+            return q.drain(..k).map(|b| (b, Source::Class(i as u8))).collect();
         }
-        let k = (n - taken.len()).min(self.deferred.len());
-        taken.extend(self.deferred.drain(..k).map(|b| (b, Source::Deferred)));
-        taken
+        let k = n.min(self.deferred.len());
+        self.deferred
+            .drain(..k)
+            .map(|b| (b, Source::Deferred))
+            .collect()
     }
 
     /// Puts `items` (from [`Self::take_front`]) back at the fronts of their queues, in their

@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::delaunay::Probe;
-use crate::refine::levels::Request;
+use crate::refine::levels::{FacetLevel, Request};
 use crate::refine::queue::book;
 
 /// The unit cube meshed to a conforming boundary and marked: its domain and regions.
@@ -76,7 +76,7 @@ fn encroached_element_gone_after_resettling_is_not_split() {
         .dom
         .judge(Boundary::Segment(0, 1), 20.0 * 0.5, Request::Shape);
     let outcome = refiner
-        .yield_to_boundary(bad.tet, conflict)
+        .yield_to_boundary(bad.tet, conflict, None)
         .expect("no split of a subsegment that is gone");
     assert_eq!(outcome, Some(Outcome::Resettled));
     assert_eq!(dom.dt.num_vertices(), expected);
@@ -111,7 +111,10 @@ fn refusals_are_counted_and_cascades_remembered() {
     let conflict = refiner
         .dom
         .judge(Boundary::Segment(seg.0, seg.1), 5.0 * rb, Request::Shape);
-    let outcome = refiner.yield_to_boundary(t, conflict).unwrap().unwrap();
+    let outcome = refiner
+        .yield_to_boundary(t, conflict, None)
+        .unwrap()
+        .unwrap();
     assert_eq!(outcome, Outcome::Refused(Refusal::Cascade));
     assert!(book(&mut refiner, bad, outcome, n).unwrap());
     let again = refiner.refine(bad, false).unwrap();
