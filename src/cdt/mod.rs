@@ -665,7 +665,22 @@ impl FacetMesh {
     /// The facet triangle holding p (projected on the facet plane; closed triangles, a point on
     /// a shared edge or vertex gets one of them), or None if p is outside the facet.
     pub fn locate(&self, p: DVec3) -> Option<[u32; 3]> {
-        let t = match self.walk(self.proj(p)) {
+        self.locate_from(self.hint, p)
+    }
+
+    /// [`Self::locate`], walking from a triangle at vertex `near` (a global id of the facet;
+    /// else from the last insertion): short when `near` is close to `p`, wherever the facet
+    /// was changed last.
+    pub fn locate_near(&self, p: DVec3, near: u32) -> Option<[u32; 3]> {
+        let start = self
+            .local
+            .get(&near)
+            .map_or(self.hint, |&l| self.vtri[l as usize]);
+        self.locate_from(start, p)
+    }
+
+    fn locate_from(&self, start: u32, p: DVec3) -> Option<[u32; 3]> {
+        let t = match self.walk_from(start, self.proj(p)) {
             Loc::Outside => return None,
             Loc::In(t) => t,
             Loc::Edge(t, i) => match self.tris[t as usize].n[i] {

@@ -295,7 +295,12 @@ impl FacetMesh {
 
     /// Stochastic visibility walk from the hint to projected point q.
     pub(super) fn walk(&self, q: DVec2) -> Loc {
-        let (mut t, mut came) = (self.hint, 3);
+        self.walk_from(self.hint, q)
+    }
+
+    /// Stochastic visibility walk from triangle `start` to projected point q.
+    pub(super) fn walk_from(&self, start: u32, q: DVec2) -> Loc {
+        let (mut t, mut came) = (start, 3);
         let mut rng = (q.x.to_bits() ^ q.y.to_bits().rotate_left(29)) as u32 | 1;
         for _ in 0..4 * self.tris.len() + 64 {
             let tr = self.tris[t as usize];

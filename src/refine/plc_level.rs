@@ -307,7 +307,7 @@ impl Domain {
         if let Some((a, c)) = enc {
             return self.plan_segment_split(a, c, picker, buf);
         }
-        if self.facets[f as usize].locate(cf).is_none() {
+        if self.facets[f as usize].locate_near(cf, t[0]).is_none() {
             return SplitPlan::Refused(Refusal::SubfacetCentreOutside);
         }
         let rf = cf.distance(x);
@@ -327,7 +327,7 @@ impl Domain {
             );
             let p = cf + (u * th.cos() + w * th.sin()) * (s * picker.delta * rf);
             let p = snap.apply(p);
-            if self.facets[f as usize].locate(p).is_none()
+            if self.facets[f as usize].locate_near(p, t[0]).is_none()
                 || balls.iter().any(|b| p.distance_squared(b.centre) <= b.r2)
             {
                 continue;
