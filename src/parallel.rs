@@ -96,32 +96,6 @@ pub fn map_collect<T: Sync, U: Send>(items: &[T], f: impl Fn(&T) -> U + Sync + S
     out
 }
 
-/// `items.iter().map(|x| f(&mut state, x)).collect()` with a `state` made by `init` per
-/// piece of work (scratch buffers), on the run's threads when `items` has at least
-/// `min_parallel` items, each thread taking at least `min_len`: the same vector for every
-/// thread count as long as `f`'s value does not depend on what the state holds.
-pub fn map_collect_init<T: Sync, S, U: Send>(
-    items: &[T],
-    min_parallel: usize,
-    min_len: usize,
-    init: impl Fn() -> S + Sync + Send,
-    f: impl Fn(&mut S, &T) -> U + Sync + Send,
-) -> Vec<U> {
-    if items.len() < min_parallel.max(2) || current_threads() <= 1 {
-        let mut state = init();
-        return items.iter().map(|x| f(&mut state, x)).collect();
-    }
-    let mut out = Vec::with_capacity(items.len());
-    install(|| {
-        items
-            .par_iter()
-            .with_min_len(min_len.max(1))
-            .map_init(&init, &f)
-            .collect_into_vec(&mut out)
-    });
-    out
-}
-
 /// The first index whose item satisfies `pred` (as `items.iter().position(pred)`), on the run's
 /// threads when `items` is long.
 pub fn position_first<T: Sync>(

@@ -4,7 +4,7 @@
 
 use super::plc_level::FacetSplitCache;
 use crate::cdt::{Change, FacetMesh};
-use crate::delaunay::{Delaunay, DelaunayError, Inserted, OwnedCavity};
+use crate::delaunay::{Cavity, Delaunay, Inserted};
 use crate::plc::{Plc, PlcInput};
 use crate::run::error::MeshError;
 use glam::DVec3;
@@ -339,30 +339,18 @@ impl Domain {
     }
 
     /// Inserts a new vertex into the 3D triangulation, located from `hint`, or with
-    /// `probed`'s cavity when that is a probe of `p` still intact (one made since the last
-    /// change, or since removals began to be tracked).
+    /// `probed`'s cavity when that is a current probe of `p`.
     pub fn insert_point(
         &mut self,
         p: DVec3,
         kind: VertexKind,
         hint: Option<u32>,
-        probed: Option<&OwnedCavity>,
+        probed: Option<Cavity>,
     ) -> Result<u32, MeshError> {
         let inserted = match probed {
-            Some(c) if c.point() == p && c.intact(&self.dt) => self.dt.insert_owned(c),
+            Some(c) if c.point() == p && self.dt.is_current(&c) => self.dt.insert_cavity(c),
             _ => self.dt.insert(p, hint),
         };
-        self.record_insertion(p, kind, inserted)
-    }
-
-    /// The books of an insertion of `p` as a `kind` vertex: its kind, protecting apex and
-    /// small-angle status, the boundary elements around it queued, its tets logged.
-    fn record_insertion(
-        &mut self,
-        p: DVec3,
-        kind: VertexKind,
-        inserted: Result<Inserted, DelaunayError>,
-    ) -> Result<u32, MeshError> {
         match inserted {
             Ok(Inserted::New(id)) => {
                 let apex = self.apex_of(p, kind);
@@ -423,7 +411,7 @@ impl Domain {
         a: u32,
         b: u32,
         p: DVec3,
-        probed: Option<&OwnedCavity>,
+        probed: Option<Cavity>,
     ) -> Result<u32, MeshError> {
         let key = seg_key(a, b);
         let seg = *self
@@ -486,7 +474,7 @@ impl Domain {
         f: u32,
         p: DVec3,
         hint: Option<u32>,
-        probed: Option<&OwnedCavity>,
+        probed: Option<Cavity>,
     ) -> Result<u32, MeshError> {
         // Checked before the 3D insertion so that a refusal leaves both triangulations as
         // they were.

@@ -21,7 +21,7 @@ use crate::geom::circumsphere;
 use crate::geom::screen::{shortest_edge_sq, sliver_measures, SliverScreen};
 use crate::run::error::MeshError;
 use glam::DVec3;
-use rand::{Rng, SeedableRng};
+use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
 /// What a higher level's refinement point would do to the level below it.
@@ -148,69 +148,9 @@ impl Score {
 }
 
 /// A probed candidate point and its score.
-pub(crate) struct Candidate<C> {
+pub(crate) struct Candidate {
     pub score: Score,
-    pub cavity: C,
-}
-
-/// How Li's point choice probes its candidates: through a level's triangulation (its one set
-/// of search buffers, the cavity a [`Cavity`] token: [`LevelProbe`]), or through a shared
-/// reference with buffers of its own, the cavity owned, so that several threads choose points
-/// at once (`refine::plan`).
-pub(crate) trait Probing {
-    /// A probed point's cavity.
-    type Cavity;
-
-    /// Probes `p` (walking from `hint`), `watch` seeing its cavity's boundary faces: None when
-    /// the watch stopped the search or `p` is a vertex.
-    fn probe(
-        &mut self,
-        p: DVec3,
-        hint: Option<u32>,
-        watch: &mut impl CavityWatch,
-    ) -> Option<Self::Cavity>;
-
-    /// The small slivers (circumradius <= b r) inserting `cavity`'s point would create.
-    fn small_slivers(&mut self, picker: &Picker, cavity: &Self::Cavity, r: f64) -> Score;
-
-    /// Whether inserting `cavity`'s point would break the boundary (the level's conflict test
-    /// without a policy).
-    fn encroaches(&mut self, cavity: &Self::Cavity) -> bool;
-
-    /// Keeps `cavity` for its insertion while other points are probed.
-    fn keep(&mut self, cavity: &Self::Cavity);
-}
-
-/// A [`FacetLevel`]'s own triangulation as [`Probing`].
-pub(crate) struct LevelProbe<'a, F: ?Sized>(pub &'a mut F);
-
-impl<F: FacetLevel + ?Sized> Probing for LevelProbe<'_, F> {
-    type Cavity = Cavity;
-
-    fn probe(
-        &mut self,
-        p: DVec3,
-        hint: Option<u32>,
-        watch: &mut impl CavityWatch,
-    ) -> Option<Cavity> {
-        match self.0.triangulation().probe_watched(p, hint, watch)? {
-            Probe::Cavity(cavity) => Some(cavity),
-            Probe::Duplicate(_) => None,
-        }
-    }
-
-    fn small_slivers(&mut self, picker: &Picker, cavity: &Cavity, r: f64) -> Score {
-        let dt = self.0.triangulation();
-        picker.small_slivers_of(cavity.point(), dt.cavity(cavity).1, dt.points(), r)
-    }
-
-    fn encroaches(&mut self, cavity: &Cavity) -> bool {
-        self.0.encroached(cavity).is_some()
-    }
-
-    fn keep(&mut self, cavity: &Cavity) {
-        self.0.triangulation().keep(cavity);
-    }
+    pub cavity: Cavity,
 }
 
 impl Picker {
@@ -230,14 +170,6 @@ impl Picker {
             slivers: SliverBounds::new(sigma0, min_dihedral_deg),
             screen: SliverScreen::new(sigma0, min_dihedral_deg),
             give_up: None,
-        }
-    }
-
-    /// The same point choice drawing from a generator seeded with `seed`.
-    pub fn reseeded(&self, seed: u64) -> Picker {
-        Picker {
-            rng: ChaCha8Rng::seed_from_u64(seed),
-            ..*self
         }
     }
 
@@ -265,17 +197,10 @@ impl Picker {
         centre + random_in_unit_ball(&mut self.rng) * (self.delta * r)
     }
 
-    /// The small slivers (circumradius <= b r) inserting point `p` with cavity boundary
-    /// `faces` would create.
-    pub fn small_slivers_of(
-        &self,
-        p: DVec3,
-        faces: &[BoundaryFace],
-        points: &[DVec3],
-        r: f64,
-    ) -> Score {
-        let mut count = self.sliver_count(p, r, None);
-        count.faces(faces, points);
+    /// The small slivers (circumradius <= b r) inserting the probed point would create.
+    pub fn small_slivers(&self, dt: &Delaunay, cavity: &Cavity, r: f64) -> Score {
+        let mut count = self.sliver_count(cavity.point(), r, None);
+        count.faces(dt.cavity(cavity).1, dt.points());
         count.score
     }
 
@@ -347,62 +272,65 @@ impl CavityWatch for SliverCount<'_> {
 
 /// Probes candidate `p` for an element of radius `r` and makes it `best` if it creates fewer
 /// small slivers (ties: the larger smallest dihedral angle) and, when `check_conflict`, breaks
-/// nothing below (`Probing::encroaches`). Returns true when `p` creates no small sliver (the
-/// search can stop; `best`'s cavity is then kept).
-pub(crate) fn try_candidate<P: Probing>(
-    prober: &mut P,
+/// nothing below (`level.encroached`). Returns true when `p` creates no small sliver (the
+/// search can stop; `best`'s cavity is then current).
+pub(crate) fn try_candidate<F: FacetLevel + ?Sized>(
+    level: &mut F,
     picker: &Picker,
     p: DVec3,
     r: f64,
     hint: Option<u32>,
     check_conflict: bool,
-    best: &mut Option<Candidate<P::Cavity>>,
+    best: &mut Option<Candidate>,
 ) -> bool {
     let limit = best.as_ref().map(|b| b.score);
     let mut count = picker.sliver_count(p, r, limit);
-    let Some(cavity) = prober.probe(p, hint, &mut count) else {
-        return false; // more small slivers than the best, or a vertex
+    let Some(probe) = level.triangulation().probe_watched(p, hint, &mut count) else {
+        return false; // more small slivers than the best
+    };
+    let Probe::Cavity(cavity) = probe else {
+        return false;
     };
     let score = count.score;
     if best.as_ref().is_some_and(|b| !score.better_than(&b.score)) {
         return false; // not better: whether it breaks the boundary does not matter
     }
-    if check_conflict && prober.encroaches(&cavity) {
+    if check_conflict && level.encroached(&cavity).is_some() {
         return false; // p would break the boundary
     }
     // Inserting the best needs no second search.
-    prober.keep(&cavity);
+    level.triangulation().keep(&cavity);
     *best = Some(Candidate { score, cavity });
     score.n_small == 0
 }
 
 /// Li's choice for a bad cell of circumradius `r` whose circumcentre `centre` breaks nothing
 /// below (`centre_cavity`: its probe, None when it is a vertex): the centre if it creates no
-/// small sliver, else the best of `max_tries` random points of the picking ball (drawn with
-/// `picker`'s generator) that break nothing below. None when no candidate was kept.
-pub(crate) fn pick_in_ball<P: Probing>(
-    prober: &mut P,
+/// small sliver, else the best of `max_tries` random points of the picking ball that break
+/// nothing below. None when no candidate was kept.
+pub(crate) fn pick_in_ball<F: FacetLevel + ?Sized>(
+    level: &mut F,
     picker: &mut Picker,
     centre: DVec3,
-    centre_cavity: Option<P::Cavity>,
+    centre_cavity: Option<Cavity>,
     r: f64,
     hint: u32,
-) -> Option<P::Cavity> {
+) -> Option<Cavity> {
     let mut best = None;
     // The centre is a point of the picking ball too, and its cavity is at hand: the first
     // candidate.
     if let Some(cavity) = centre_cavity {
-        let score = prober.small_slivers(picker, &cavity, r);
-        prober.keep(&cavity);
+        let score = picker.small_slivers(level.triangulation(), &cavity, r);
+        level.triangulation().keep(&cavity);
         best = Some(Candidate { score, cavity });
     }
     if best.as_ref().is_none_or(|b| b.score.n_small > 0) {
         for draws in 0..picker.max_tries {
-            if picker.gives_up(draws, best.as_ref().map(|b| &b.score)) {
+            if picker.gives_up(draws, best.as_ref().map(|b: &Candidate| &b.score)) {
                 break;
             }
             let p = picker.in_ball(centre, r);
-            if try_candidate(prober, picker, p, r, Some(hint), true, &mut best) {
+            if try_candidate(level, picker, p, r, Some(hint), true, &mut best) {
                 break;
             }
         }

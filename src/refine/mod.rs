@@ -5,7 +5,6 @@
 pub mod background;
 #[cfg(test)]
 mod check;
-mod classify;
 mod domain;
 pub mod existing;
 pub(crate) mod levels;
@@ -13,7 +12,6 @@ mod mark;
 mod marker_size;
 pub(crate) mod outcome;
 mod output;
-mod plan;
 mod plc_level;
 mod quality;
 pub(crate) mod queue;

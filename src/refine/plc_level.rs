@@ -10,11 +10,8 @@
 use super::domain::{seg_key, tri_key, Domain, VertexKind};
 use super::levels::{try_candidate, Conflict, FacetLevel, Picker, Request};
 use super::outcome::{BoundaryKind, Outcome, Refusal};
-use super::plan::SharedProbing;
 use super::recover::{Settled, MAX_RECOVERY_SPLITS};
-use crate::delaunay::{
-    tables::FACE, BoundaryFace, Cavity, Delaunay, OwnedCavity, ProbeBuffers, INFINITE,
-};
+use crate::delaunay::{tables::FACE, Cavity, Delaunay, INFINITE};
 use crate::geom::{diametric_ball, equatorial_ball, tri_circumcenter};
 use crate::run::error::MeshError;
 use glam::DVec3;
@@ -68,8 +65,7 @@ impl FacetLevel for Domain {
         b: Boundary,
         picker: &mut Picker,
     ) -> Result<Outcome, MeshError> {
-        let plan = self.plan_split(b, picker, &mut ProbeBuffers::default());
-        self.apply_split(plan)
+        self.split_boundary(b, picker)
     }
 }
 
@@ -80,33 +76,9 @@ impl Domain {
     /// inner side does not have p in its circumsphere); of the encroached elements it names
     /// the smallest subsegment (by key), else the smallest subfacet.
     fn boundary_in_cavity(&self, cavity: &Cavity) -> Option<Boundary> {
-        let (removed, faces) = self.dt.cavity(cavity);
-        self.boundary_in(cavity.point(), removed, faces)
-    }
-
-    /// [`Self::boundary_in_cavity`] of a cavity probed through a shared reference.
-    pub(super) fn boundary_in_owned(&self, cavity: &OwnedCavity) -> Option<Boundary> {
-        self.boundary_in(cavity.point(), cavity.tets(), cavity.boundary())
-    }
-
-    /// The conflict test of a cell's point with its cavity probed through a shared reference
-    /// (as `FacetLevel::conflict`).
-    pub(super) fn conflict_owned(
-        &self,
-        cavity: &OwnedCavity,
-        r: f64,
-        request: Request,
-    ) -> Conflict<Boundary> {
-        match self.boundary_in_owned(cavity) {
-            None => Conflict::Free,
-            Some(b) => self.judge(b, r, request),
-        }
-    }
-
-    /// The boundary element whose protection inserting `p` would violate, its cavity being the
-    /// tets `removed` with boundary `faces` (see [`Self::boundary_in_cavity`]).
-    fn boundary_in(&self, p: DVec3, removed: &[u32], faces: &[BoundaryFace]) -> Option<Boundary> {
         let dom = self;
+        let p = cavity.point();
+        let (removed, faces) = dom.dt.cavity(cavity);
         // Every vertex of a cavity tet is on the cavity's boundary, and a ring tet adds one
         // vertex to a boundary face: if no boundary face has a vertex on the domain boundary,
         // no cavity or ring tet has two, so the scan below would find no subsegment or
@@ -226,46 +198,18 @@ impl Domain {
         }
     }
 
-    /// Where boundary element `b` will be split (from its picking region, drawing with
-    /// `picker`), decided without changing anything: several are planned at once on the run's
-    /// threads (`refine::plan`), and [`Self::apply_split`] carries the plan out.
-    pub(super) fn plan_split(
-        &self,
-        b: Boundary,
-        picker: &mut Picker,
-        buf: &mut ProbeBuffers,
-    ) -> SplitPlan {
-        match b {
-            Boundary::Segment(a, c) => self.plan_segment_split(a, c, picker, buf),
-            Boundary::Facet(f, t) => self.plan_subfacet_split(f, t, picker, buf),
-        }
-    }
-
-    /// Carries out split plan `plan` (which the caller found still valid), then restores
-    /// empty encroachment around the new vertex (the subsegment and subfacet queues,
-    /// `Domain::settle`).
-    pub(super) fn apply_split(&mut self, plan: SplitPlan) -> Result<Outcome, MeshError> {
-        let split = match plan {
-            SplitPlan::Refused(reason) => return Ok(Outcome::Refused(reason)),
-            SplitPlan::Segment {
-                a,
-                c,
-                point,
-                cavity,
-            } => {
-                self.split_subsegment(a, c, point, cavity.as_ref())?;
+    /// Splits boundary element `b` from its picking region, then restores empty encroachment
+    /// around the new vertex (the subsegment and subfacet queues, `Domain::settle`).
+    fn split_boundary(&mut self, b: Boundary, picker: &mut Picker) -> Result<Outcome, MeshError> {
+        let split = match b {
+            Boundary::Segment(a, c) => {
+                self.split_segment_picked(a, c, picker)?;
                 BoundaryKind::Segment
             }
-            SplitPlan::Facet {
-                f,
-                t,
-                point,
-                cavity,
-            } => {
-                let hint = self.dt.vertex_tet(t[0]);
-                self.split_in_facet(f, point, hint, cavity.as_ref())?;
-                BoundaryKind::Facet
-            }
+            Boundary::Facet(f, t) => match self.split_subfacet_picked(f, t, picker)? {
+                Ok(kind) => kind,
+                Err(refusal) => return Ok(Outcome::Refused(refusal)),
+            },
         };
         let mut budget = MAX_RECOVERY_SPLITS;
         Ok(match self.settle(&mut budget)? {
@@ -274,30 +218,23 @@ impl Domain {
         })
     }
 
-    /// The split of subfacet `t` of facet `f` from its picking disk (its circumcentre first,
-    /// then random draws), or of the facet's subsegment that centre encroaches, or why
-    /// nothing is split.
-    fn plan_subfacet_split(
-        &self,
+    /// Splits subfacet `t` of facet `f` from its picking disk (its circumcentre first, then
+    /// random draws), or the facet's subsegment that centre encroaches. Returns the kind of
+    /// element split, or why nothing was.
+    fn split_subfacet_picked(
+        &mut self,
         f: u32,
         t: [u32; 3],
         picker: &mut Picker,
-        buf: &mut ProbeBuffers,
-    ) -> SplitPlan {
+    ) -> Result<Result<BoundaryKind, Refusal>, MeshError> {
         let [x, y, z] = t.map(|v| self.point(v));
         let Some(cf) = tri_circumcenter(x, y, z) else {
-            return SplitPlan::Refused(Refusal::FlatSubfacet);
+            return Ok(Err(Refusal::FlatSubfacet));
         };
         // The facet's plane snap and subsegment balls, once for the centre and all the draws
-        // (the same tests as snap_to_facet_plane and facet_subsegments_encroached_by).
-        let walked;
-        let (snap, balls) = match self.split_caches.get(f as usize) {
-            Some(Some(cache)) => (cache.snap, &cache.balls[..]),
-            _ => {
-                walked = subsegment_balls(self, f);
-                (PlaneSnap::of(self, f), &walked[..])
-            }
-        };
+        // (the same tests as snap_to_facet_plane and facet_subsegments_encroached_by, which
+        // walk the whole facet).
+        let (snap, balls) = self.split_cache(f);
         let cf = snap.apply(cf);
         let enc = balls
             .iter()
@@ -305,10 +242,11 @@ impl Domain {
             .map(|b| b.key)
             .min();
         if let Some((a, c)) = enc {
-            return self.plan_segment_split(a, c, picker, buf);
+            self.split_segment_picked(a, c, picker)?;
+            return Ok(Ok(BoundaryKind::Segment));
         }
         if self.facets[f as usize].locate_near(cf, t[0]).is_none() {
-            return SplitPlan::Refused(Refusal::SubfacetCentreOutside);
+            return Ok(Err(Refusal::SubfacetCentreOutside));
         }
         let rf = cf.distance(x);
         let n = (y - x).cross(z - x).normalize();
@@ -317,8 +255,7 @@ impl Domain {
         // The centre first (it passed the facet checks above), then random draws.
         let mut best = None;
         let hint = self.dt.vertex_tet(t[0]);
-        let mut probing = SharedProbing::new(self, buf);
-        let centre_ok = try_candidate(&mut probing, picker, cf, rf, hint, false, &mut best);
+        let centre_ok = try_candidate(self, picker, cf, rf, hint, false, &mut best);
         let tries = if centre_ok { 0 } else { picker.max_tries };
         for _ in 0..tries {
             let (s, th) = (
@@ -332,59 +269,60 @@ impl Domain {
             {
                 continue;
             }
-            if try_candidate(&mut probing, picker, p, rf, hint, false, &mut best) {
+            let hint = self.dt.vertex_tet(t[0]);
+            if try_candidate(self, picker, p, rf, hint, false, &mut best) {
                 break;
             }
         }
-        let (point, cavity) = match best {
+        let (p, cavity) = match best {
             Some(c) => (c.cavity.point(), Some(c.cavity)),
             None => (cf, None),
         };
-        SplitPlan::Facet {
-            f,
-            t,
-            point,
-            cavity,
+        let hint = self.dt.vertex_tet(t[0]);
+        self.split_in_facet(f, p, hint, cavity)?;
+        Ok(Ok(BoundaryKind::Facet))
+    }
+
+    /// Facet `f`'s plane snap and subsegment balls (from its split cache, built now if it was
+    /// not: walking the whole facet for every split made keep mode quadratic in a facet's
+    /// size).
+    fn split_cache(&mut self, f: u32) -> (PlaneSnap, Vec<SubsegmentBall>) {
+        if self.split_caches.len() < self.facets.len() {
+            self.split_caches.resize_with(self.facets.len(), || None);
         }
+        if self.split_caches[f as usize].is_none() {
+            let cache = FacetSplitCache {
+                snap: PlaneSnap::of(self, f),
+                balls: subsegment_balls(self, f),
+            };
+            self.split_caches[f as usize] = Some(cache);
+        }
+        let cache = self.split_caches[f as usize]
+            .as_ref()
+            .map(|c| (c.snap, c.balls.clone()));
+        cache.unwrap_or_else(|| (PlaneSnap::of(self, f), subsegment_balls(self, f)))
     }
 
-    /// Builds every facet's split cache (plane snap and subsegment balls), so that splits can
-    /// be planned through a shared reference: walking the whole facet for every split made
-    /// keep mode quadratic in a facet's size.
-    pub(super) fn build_split_caches(&mut self) {
-        let caches = (0..self.facets.len() as u32)
-            .map(|f| {
-                Some(FacetSplitCache {
-                    snap: PlaneSnap::of(self, f),
-                    balls: subsegment_balls(self, f),
-                })
-            })
-            .collect();
-        self.split_caches = caches;
-    }
-
-    /// The split of subsegment ac from its picking interval (midpoint +- delta/2 of its
-    /// length), or at the concentric-shell point next to an acute input vertex.
-    fn plan_segment_split(
-        &self,
+    /// Splits subsegment ac from its picking interval (midpoint +- delta/2 of its length), or at
+    /// the concentric-shell point next to an acute input vertex.
+    fn split_segment_picked(
+        &mut self,
         a: u32,
         c: u32,
         picker: &mut Picker,
-        buf: &mut ProbeBuffers,
-    ) -> SplitPlan {
+    ) -> Result<(), MeshError> {
         let (pa, pc) = (self.point(a), self.point(c));
         let shell = self.acute_vertices.contains(&a) != self.acute_vertices.contains(&c);
-        let (point, cavity) = if shell {
+        let (p, cavity) = if shell {
             (self.segment_split_point(a, c), None)
         } else {
             let r = 0.5 * pa.distance(pc);
             let mut best = None;
-            let hint = self.dt.vertex_tet(a);
-            let mut probing = SharedProbing::new(self, buf);
             for _ in 0..picker.max_tries {
                 let t = 0.5 + picker.rng.gen_range(-0.5..0.5) * picker.delta;
                 let p = pa + (pc - pa) * t;
-                if try_candidate(&mut probing, picker, p, r, hint, false, &mut best) {
+                let hint = self.dt.vertex_tet(a);
+                if try_candidate(self, picker, p, r, hint, false, &mut best) {
                     break;
                 }
             }
@@ -393,54 +331,8 @@ impl Domain {
                 None => (pa + (pc - pa) * 0.5, None),
             }
         };
-        SplitPlan::Segment {
-            a,
-            c,
-            point,
-            cavity,
-        }
-    }
-}
-
-/// Where a boundary element will be split, decided without changing anything
-/// ([`Domain::plan_split`]).
-#[derive(Debug)]
-pub(crate) enum SplitPlan {
-    /// Split subsegment ac at `point` (with its probed cavity, if one was kept).
-    Segment {
-        a: u32,
-        c: u32,
-        point: DVec3,
-        cavity: Option<OwnedCavity>,
-    },
-    /// Split subfacet `t` of facet `f` at `point`.
-    Facet {
-        f: u32,
-        t: [u32; 3],
-        point: DVec3,
-        cavity: Option<OwnedCavity>,
-    },
-    /// Nothing can be split, for this reason.
-    Refused(Refusal),
-}
-
-impl SplitPlan {
-    /// Whether the plan, made earlier in a batch, still holds: the element is still a
-    /// subsegment or subfacet and its point's cavity is intact (a plan without a probed cavity
-    /// is made again). A refusal holds while the element that asked for it does (the caller
-    /// knows).
-    pub(super) fn still_valid(&self, dom: &Domain) -> bool {
-        match self {
-            SplitPlan::Refused(_) => true,
-            SplitPlan::Segment { a, c, cavity, .. } => {
-                dom.subsegs.contains_key(&seg_key(*a, *c))
-                    && cavity.as_ref().is_some_and(|k| k.intact(&dom.dt))
-            }
-            SplitPlan::Facet { t, cavity, .. } => {
-                dom.subfacets.contains_key(&tri_key(*t))
-                    && cavity.as_ref().is_some_and(|k| k.intact(&dom.dt))
-            }
-        }
+        self.split_subsegment(a, c, p, cavity)?;
+        Ok(())
     }
 }
 

@@ -25,16 +25,6 @@ pub(crate) struct BadQueues<T> {
     deferred: VecDeque<T>,
 }
 
-/// Elements taken from the queues, each with where it came from.
-pub(crate) type Taken<T> = Vec<(T, Source)>;
-
-/// The queue an element was taken from: its class's, or the deferred queue.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Source {
-    Class(u8),
-    Deferred,
-}
-
 impl<T> Default for BadQueues<T> {
     fn default() -> Self {
         BadQueues {
@@ -62,37 +52,6 @@ impl<T> BadQueues<T> {
             return Some((b, false));
         }
         self.deferred.pop_front().map(|b| (b, true))
-    }
-
-    /// Takes up to `n` elements from the front of the queue [`Self::pop`] would take from
-    /// next (one class, or the deferred queue: a batch never mixes classes, so the higher
-    /// classes are still worked off first), each with the queue it came from (for
-    /// [`Self::put_front`]).
-    pub(crate) fn take_front(&mut self, n: usize) -> Vec<(T, Source)> {
-        if let Some(i) = (0..self.queues.len())
-            .rev()
-            .find(|&i| !self.queues[i].is_empty())
-        {
-            let q = &mut self.queues[i];
-            let k = n.min(q.len());
-            return q.drain(..k).map(|b| (b, Source::Class(i as u8))).collect();
-        }
-        let k = n.min(self.deferred.len());
-        self.deferred
-            .drain(..k)
-            .map(|b| (b, Source::Deferred))
-            .collect()
-    }
-
-    /// Puts `items` (from [`Self::take_front`]) back at the fronts of their queues, in their
-    /// order: popped next, before what was queued.
-    pub(crate) fn put_front(&mut self, items: impl DoubleEndedIterator<Item = (T, Source)>) {
-        for (b, source) in items.rev() {
-            match source {
-                Source::Class(i) => self.queues[i as usize].push_front(b),
-                Source::Deferred => self.deferred.push_front(b),
-            }
-        }
     }
 
     /// Every element still queued, deferred ones included (in no particular order).
@@ -153,9 +112,6 @@ pub(crate) enum Ended {
     Cancelled,
 }
 
-/// A planned batch is chosen among this many times its size of the next queued elements.
-const WINDOW_PER_BATCH: usize = 4;
-
 /// Steps between two calls of the progress callback.
 const PROGRESS_EVERY: usize = 1024;
 
@@ -187,100 +143,6 @@ pub(crate) fn work_off<L: BadLevel>(
         }
         let n_before = level.num_vertices();
         let outcome = level.refine(bad, deferred)?;
-        if !book(level, bad, outcome, n_before)? {
-            return Ok(Ended::Stopped);
-        }
-    }
-}
-
-/// A [`BadLevel`] that plans the refinement of its next elements ahead, all at once (on the
-/// run's threads), and applies the plans in queue order ([`work_off_planned`]).
-pub(crate) trait PlannedLevel: BadLevel {
-    /// What refining one element will do, decided without changing anything.
-    type Plan: Send;
-
-    /// How many queued elements are planned together.
-    fn batch_size(&self) -> usize;
-
-    /// Which of `window` (the next queued elements, in order) to plan together, at most
-    /// `size`: the level drops those that are no longer bad and leaves out those whose
-    /// refinement would likely meet a chosen one's (their plans would not hold); the rest are
-    /// queued again right after the chosen ones, in order. Chosen first, then the rest.
-    fn select(
-        &mut self,
-        window: Taken<Self::Bad>,
-        size: usize,
-    ) -> (Taken<Self::Bad>, Taken<Self::Bad>);
-
-    /// The plans of `batch` (each element with whether it was deferred), in its order, made
-    /// against the mesh as it is now: each depends only on the mesh and its element.
-    fn plan_batch(&mut self, batch: &[(Self::Bad, bool)]) -> Vec<Self::Plan>;
-
-    /// Refines `bad` (`deferred`: taken from the deferred queue) with `plan` if it still
-    /// holds, else with a plan made now; says what it did.
-    fn refine_planned(
-        &mut self,
-        bad: Self::Bad,
-        deferred: bool,
-        plan: Option<Self::Plan>,
-    ) -> Result<Outcome, Self::Error>;
-
-    /// After a batch's plans are used up, before the next is planned (e.g. queue the bad
-    /// elements the batch made).
-    fn after_batch(&mut self) -> Result<(), Self::Error>;
-}
-
-/// [`work_off`] for a [`PlannedLevel`]: the next `batch_size` plannable elements in queue
-/// order are planned together, then taken and refined one by one as `work_off` does, each
-/// with its plan (an element taken that has none, e.g. one queued since, is planned then).
-/// The plans and the order do not depend on how the planning is spread over threads.
-pub(crate) fn work_off_planned<L: PlannedLevel>(
-    level: &mut L,
-    progress: &mut dyn FnMut(usize) -> bool,
-) -> Result<Ended, L::Error>
-where
-    L::Bad: PartialEq,
-{
-    let mut steps = 0usize;
-    let mut plans: VecDeque<(L::Bad, L::Plan)> = VecDeque::new();
-    loop {
-        if !level.before_next() {
-            return Ok(Ended::Stopped);
-        }
-        if plans.is_empty() {
-            level.after_batch()?;
-            // The batch: chosen among the next few times its size in queue order, and
-            // queued first.
-            let size = level.batch_size();
-            let window = level.queues().take_front(WINDOW_PER_BATCH * size);
-            let (chosen, rest) = level.select(window, size);
-            let batch: Vec<(L::Bad, bool)> = chosen
-                .iter()
-                .map(|&(b, source)| (b, source == Source::Deferred))
-                .collect();
-            level.queues().put_front(chosen.into_iter().chain(rest));
-            let made = level.plan_batch(&batch);
-            plans.extend(batch.into_iter().map(|(b, _)| b).zip(made));
-        }
-        let Some((mut bad, deferred)) = level.queues().pop() else {
-            return Ok(Ended::Done);
-        };
-        let plan = match plans.front() {
-            Some((b, _)) if *b == bad => plans.pop_front().map(|(_, p)| p),
-            _ => None,
-        };
-        if !level.still_bad(&mut bad) {
-            continue;
-        }
-        if !level.within_budget(&bad) {
-            return Ok(Ended::Stopped);
-        }
-        steps += 1;
-        if steps % PROGRESS_EVERY == 0 && !progress(level.num_vertices()) {
-            return Ok(Ended::Cancelled);
-        }
-        let n_before = level.num_vertices();
-        let outcome = level.refine_planned(bad, deferred, plan)?;
         if !book(level, bad, outcome, n_before)? {
             return Ok(Ended::Stopped);
         }

@@ -17,7 +17,7 @@ use crate::delaunay::tables::FACE;
 use crate::delaunay::{Inserted, Probe, INFINITE};
 use crate::geom::screen::{shortest_edge_sq, sliver_measures};
 use crate::refine::levels::{
-    pick_in_ball, Conflict, FacetLevel, GiveUp, LevelProbe, Picker, Request, SliverBounds,
+    pick_in_ball, Conflict, FacetLevel, GiveUp, Picker, Request, SliverBounds,
 };
 use crate::refine::outcome::{Outcome, Refusal};
 use crate::refine::queue::{work_off, BadLevel, BadQueues, Class, Ended};
@@ -358,14 +358,7 @@ impl SurfaceMesher<'_> {
         }
         let mut picker = self.lend_picker();
         let centre = cavity.point();
-        let picked = pick_in_ball(
-            &mut LevelProbe(self),
-            &mut picker,
-            centre,
-            Some(cavity),
-            r,
-            t,
-        );
+        let picked = pick_in_ball(self, &mut picker, centre, Some(cavity), r, t);
         self.return_picker(picker);
         // Not reached: the centre's cavity is a candidate, so one is always kept.
         let Some(cavity) = picked else {

@@ -1,8 +1,6 @@
 //! Tests of the quality refinement's decisions and books.
 
 use super::*;
-use crate::delaunay::Probe;
-use crate::refine::levels::{FacetLevel, Request};
 use crate::refine::queue::book;
 
 /// The unit cube meshed to a conforming boundary and marked: its domain and regions.
@@ -67,7 +65,7 @@ fn encroached_element_gone_after_resettling_is_not_split() {
     // smaller than the tet), the boundary is restored, and nothing else is split.
     let (mut dom, regions, t) = cube_with_unsettled_subsegment();
     let bad = Bad {
-        class: Class::Ratio,
+        class: RATIO,
         tet: t,
         verts: dom.dt.tet(t),
     };
@@ -76,7 +74,7 @@ fn encroached_element_gone_after_resettling_is_not_split() {
         .dom
         .judge(Boundary::Segment(0, 1), 20.0 * 0.5, Request::Shape);
     let outcome = refiner
-        .yield_to_boundary(bad.tet, conflict, None)
+        .yield_to_boundary(bad.tet, conflict)
         .expect("no split of a subsegment that is gone");
     assert_eq!(outcome, Some(Outcome::Resettled));
     assert_eq!(dom.dt.num_vertices(), expected);
@@ -98,7 +96,7 @@ fn refusals_are_counted_and_cascades_remembered() {
     let seg = *dom.subsegs.keys().min().unwrap();
     let rb = 0.5 * dom.point(seg.0).distance(dom.point(seg.1));
     let bad = Bad {
-        class: Class::Ratio,
+        class: RATIO,
         tet: t,
         verts: dom.dt.tet(t),
     };
@@ -111,16 +109,15 @@ fn refusals_are_counted_and_cascades_remembered() {
     let conflict = refiner
         .dom
         .judge(Boundary::Segment(seg.0, seg.1), 5.0 * rb, Request::Shape);
-    let outcome = refiner
-        .yield_to_boundary(t, conflict, None)
-        .unwrap()
-        .unwrap();
+    let outcome = refiner.yield_to_boundary(t, conflict).unwrap().unwrap();
     assert_eq!(outcome, Outcome::Refused(Refusal::Cascade));
     assert!(book(&mut refiner, bad, outcome, n).unwrap());
-    let again = refiner.refine(bad, false).unwrap();
+    let again = refiner.refine_tet(bad, true).unwrap();
     assert_eq!(again, Outcome::Refused(Refusal::Futile));
     assert!(book(&mut refiner, bad, again, n).unwrap());
-    let duplicate = Outcome::Refused(Refusal::Duplicate);
+    let on_vertex = refiner.dom.point(0);
+    let duplicate = refiner.insert_volume_point(on_vertex, 1.0, t).unwrap();
+    assert_eq!(duplicate, Outcome::Refused(Refusal::Duplicate));
     assert!(book(&mut refiner, bad, duplicate, n).unwrap());
     assert_eq!(refiner.dom.dt.num_vertices(), n);
     let r = &refiner.refusals;
@@ -238,14 +235,7 @@ fn plc_facet_level_conflicts_follow_the_request() {
     );
     let inside_cavity = probe(&mut dom, inside);
     let t = dom.dt.locate_point(inside, None);
-    let chosen = pick_in_ball(
-        &mut super::super::levels::LevelProbe(&mut dom),
-        &mut picker,
-        inside,
-        Some(inside_cavity),
-        0.2,
-        t,
-    );
+    let chosen = pick_in_ball(&mut dom, &mut picker, inside, Some(inside_cavity), 0.2, t);
     let chosen = chosen.expect("a point that breaks nothing");
     assert!(chosen.point().distance(inside) <= params.delta * 0.2);
     assert!(dom.encroached(&chosen).is_none());
