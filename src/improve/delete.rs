@@ -9,6 +9,7 @@
 //! `orient3d` the new tets tile v's star (the degree argument of `flips`). Of all neighbours,
 //! the one whose worst new tet is best is taken, if that beats the worst tet around v.
 
+use super::batch::note;
 use super::constraints::Constraint;
 use super::flips::MIN_GAIN;
 use super::Improver;
@@ -39,6 +40,7 @@ impl Improver<'_> {
             if !matches!(self.cons[v as usize], Constraint::Free) || star.len() > MAX_STAR {
                 continue;
             }
+            star.iter().for_each(|&s| note(&w.tets[s as usize]));
             let old = w.worst_q(star);
             let mut link: Vec<u32> = star
                 .iter()

@@ -21,6 +21,7 @@
 //! nothing or the budget is spent. Order: by objective, then tet slot; no hashing decides
 //! anything, so the result is deterministic.
 
+mod batch;
 mod constraints;
 mod delete;
 mod flips;
@@ -79,20 +80,21 @@ pub(crate) struct Improver<'s> {
     /// Approximate mode: the boundary vertices that slide on the input surface, and how.
     slide: Option<&'s dyn SurfaceSlide>,
     stats: ImproveStats,
-    /// Changes refused for the radius-edge bound (`ImproveStats::rho_vetoes`; counted by planners
-    /// that only read the mesh).
-    rho_vetoes: std::cell::Cell<usize>,
-    rho_yields: std::cell::Cell<usize>,
+    /// How the batches' plans made ahead fared.
+    counts: batch::Counts,
 }
 
 /// How the boundary vertices of an approximated surface may move (approximate mode): within
 /// their tangent plane, then put back on the input surface, as long as the boundary triangles
 /// around them stay close to it.
-pub trait SurfaceSlide {
+pub trait SurfaceSlide: Sync {
     /// Whether boundary vertex `v` may move (not at a corner).
     fn slides(&self, v: u32) -> bool;
     /// For a vertex on a feature curve (at `at`): the curve's direction there (it moves along
     /// it); None for a vertex inside a patch (it moves in its tangent plane).
+    ///
+    /// `Sync`: the improver plans on the run's threads (`batch`); every answer must depend on its
+    /// arguments only.
     fn along(&self, v: u32, at: DVec3) -> Option<DVec3>;
     /// `x` put on the part of the input surface where `v` may lie, or None.
     fn project(&self, v: u32, x: DVec3) -> Option<DVec3>;
@@ -181,8 +183,7 @@ fn improve_work(
         normals,
         slide,
         stats: ImproveStats::default(),
-        rho_vetoes: Default::default(),
-        rho_yields: Default::default(),
+        counts: Default::default(),
     };
     im.stats.degenerate_before = (0..im.w.tets.len())
         .filter(|&t| im.w.q[t] < SURELY_POSITIVE && !im.w.positive(im.w.tets[t]))
@@ -190,24 +191,25 @@ fn improve_work(
     if opts.improve || im.stats.degenerate_before > 0 {
         im.run(opts);
     }
-    im.stats.rho_vetoes = im.rho_vetoes.get();
-    im.stats.rho_yields = im.rho_yields.get();
+    if std::env::var_os("SLIVERMESH_IMPROVE_BATCHES").is_some() {
+        eprintln!("improve batches: {:?}", im.counts);
+    }
     im.stats.seconds = start.elapsed().as_secs_f64();
     (im.w.into_mesh(), im.stats)
 }
 
 impl Improver<'_> {
-    /// `Work::keeps_rho` as a yes or no, counting the refusals and where the bound gave way.
+    /// `Work::keeps_rho` as a yes or no, counting the refusals and where the bound gave way
+    /// (for the plan running on this thread: `batch::tallied`).
     fn keeps_rho(&self, old: &[u32], new: impl IntoIterator<Item = [DVec3; 4]>) -> bool {
-        let count = |c: &std::cell::Cell<usize>| c.set(c.get() + 1);
         match self.w.keeps_rho(old, new) {
             topo::RhoCheck::Keeps => true,
             topo::RhoCheck::GivesWay => {
-                count(&self.rho_yields);
+                batch::count_rho(false);
                 true
             }
             topo::RhoCheck::Vetoed => {
-                count(&self.rho_vetoes);
+                batch::count_rho(true);
                 false
             }
         }
@@ -281,8 +283,25 @@ impl Improver<'_> {
             .fold(f64::INFINITY, f64::min)
     }
 
+    /// Whether the heap entry (`t`, `tv`) is to be worked on now: the tet is still there and
+    /// bad, and something changed around it since it was last tried in vain.
+    fn due(&self, t: u32, tv: [u32; 4], target: f64, improve: bool, st: &PassState) -> bool {
+        let ti = t as usize;
+        if !self.w.alive[ti] || self.w.tets[ti] != tv || !self.bad(t, target, improve) {
+            return false;
+        }
+        let tried = st.tried.get(ti).copied().unwrap_or(0);
+        tried == 0 || tv.iter().any(|&v| st.stamp[v as usize] > tried)
+    }
+
     /// One pass over the tets below `target` (or only the flat and inverted ones when not
     /// `improve`), worst first; returns the number of changes.
+    ///
+    /// The heap is taken in batches of at most `batch::BATCH` due tets. With several threads
+    /// each batch's plans are made ahead on the run's threads, against the mesh as the batch
+    /// begins; then, on this thread and in heap order, each tet still due is worked on
+    /// (`work_on`) with the plans made ahead that no earlier change of the batch touched. The
+    /// tets a change makes or moves go back on the heap for a later batch.
     fn pass(&mut self, target: f64, improve: bool, st: &mut PassState) -> usize {
         self.stats.passes += 1;
         let mut heap: BinaryHeap<Reverse<(u64, u32, [u32; 4])>> = BinaryHeap::new();
@@ -295,38 +314,71 @@ impl Improver<'_> {
                 )));
             }
         }
+        let ahead = crate::parallel::current_threads() > 1;
         let mut changes = 0;
         let mut smoothings = vec![0u8; self.w.pos.len()];
-        while let Some(Reverse((_, t, tv))) = heap.pop() {
-            if changes >= st.budget {
+        // Per tet slot: the last batch that took it (a tet pushed twice goes in once).
+        let mut taken: Vec<u32> = vec![0; self.w.tets.len()];
+        let mut batch: Vec<(u32, [u32; 4])> = Vec::with_capacity(batch::BATCH);
+        while changes < st.budget {
+            self.w.epoch += 1;
+            let epoch = self.w.epoch;
+            batch.clear();
+            while batch.len() < batch::BATCH {
+                let Some(Reverse((_, t, tv))) = heap.pop() else {
+                    break;
+                };
+                if taken.len() < self.w.tets.len() {
+                    taken.resize(self.w.tets.len(), 0);
+                }
+                if taken[t as usize] != epoch && self.due(t, tv, target, improve, st) {
+                    taken[t as usize] = epoch;
+                    batch.push((t, tv));
+                }
+            }
+            if batch.is_empty() {
                 break;
             }
-            let ti = t as usize;
-            if !self.w.alive[ti] || self.w.tets[ti] != tv || !self.bad(t, target, improve) {
-                continue;
-            }
-            if st.tried[ti] != 0 && tv.iter().all(|&v| st.stamp[v as usize] <= st.tried[ti]) {
-                continue;
-            }
-            let (touched, capped) = self.work_on(t, tv, &mut smoothings, st);
-            if st.tried.len() < self.w.tets.len() {
-                st.tried.resize(self.w.tets.len(), 0);
-            }
-            if touched.is_empty() {
-                if !capped {
-                    st.tried[ti] = st.clock;
+            self.counts.batches += 1;
+            self.counts.entries += batch.len();
+            let mut plans: Vec<batch::Ahead> = if ahead {
+                let t0 = std::time::Instant::now();
+                let (this, smoothings) = (&*self, &smoothings);
+                let plans =
+                    batch::map_in_order(&batch, |&(t, tv)| this.plan_ahead(t, tv, smoothings));
+                self.stats.seconds_plans += t0.elapsed().as_secs_f64();
+                plans
+            } else {
+                vec![]
+            };
+            for (k, &(t, tv)) in batch.iter().enumerate() {
+                if changes >= st.budget {
+                    break;
                 }
-                continue;
-            }
-            changes += 1;
-            for n in touched {
-                st.tried[n as usize] = 0;
-                if self.bad(n, target, improve) {
-                    heap.push(Reverse((
-                        key(self.w.q[n as usize]),
-                        n,
-                        self.w.tets[n as usize],
-                    )));
+                if !self.due(t, tv, target, improve, st) {
+                    continue;
+                }
+                let ahead = plans.get_mut(k).map(std::mem::take).unwrap_or_default();
+                let (touched, capped) = self.work_on(t, tv, &mut smoothings, st, ahead);
+                if st.tried.len() < self.w.tets.len() {
+                    st.tried.resize(self.w.tets.len(), 0);
+                }
+                if touched.is_empty() {
+                    if !capped {
+                        st.tried[t as usize] = st.clock;
+                    }
+                    continue;
+                }
+                changes += 1;
+                for n in touched {
+                    st.tried[n as usize] = 0;
+                    if self.bad(n, target, improve) {
+                        heap.push(Reverse((
+                            key(self.w.q[n as usize]),
+                            n,
+                            self.w.tets[n as usize],
+                        )));
+                    }
                 }
             }
         }
@@ -335,19 +387,73 @@ impl Improver<'_> {
 }
 
 impl Improver<'_> {
+    /// The plans `work_on` would ask for on tet `t` (vertices `tv`) if the mesh stayed as it
+    /// is, each with its footprint (`batch`); only reads the mesh.
+    fn plan_ahead(&self, t: u32, tv: [u32; 4], smoothings: &[u8]) -> batch::Ahead {
+        let mut ahead = batch::Ahead {
+            flip: Some(batch::recorded(&tv, || self.best_plan(t))),
+            ..Default::default()
+        };
+        if ahead.flip.as_ref().is_some_and(|m| m.value.is_some()) {
+            return ahead;
+        }
+        let mut capped = false;
+        for (k, v) in tv.into_iter().enumerate() {
+            if smoothings[v as usize] >= MAX_SMOOTHINGS {
+                capped = true;
+                continue;
+            }
+            let m = batch::recorded(&[], || self.plan_smoothing(v));
+            let moves = matches!(m.value, smooth::Smoothing::Move(_));
+            ahead.smooth[k] = Some(m);
+            if moves {
+                return ahead;
+            }
+        }
+        if !capped {
+            ahead.insertion = Some(batch::recorded(&tv, || self.plan_insertion(t)));
+            ahead.deletion = Some(batch::recorded(&tv, || self.plan_deletion(t)));
+        }
+        ahead
+    }
+
+    /// `ahead`'s value if no change of this batch touched its footprint, else `plan()` made
+    /// now: the same value either way. The radius-edge tally of the one used is counted.
+    fn use_plan<T>(&mut self, ahead: Option<batch::Memo<T>>, plan: impl FnOnce(&Self) -> T) -> T {
+        let (value, tally) = match ahead {
+            Some(m) if m.footprint.iter().all(|&v| self.w.unchanged(v)) => {
+                self.counts.used += 1;
+                (m.value, m.tally)
+            }
+            ahead => {
+                if ahead.is_some() {
+                    self.counts.replanned += 1;
+                } else {
+                    self.counts.unplanned += 1;
+                }
+                batch::tallied(|| plan(self))
+            }
+        };
+        self.stats.rho_vetoes += tally.vetoes;
+        self.stats.rho_yields += tally.yields;
+        value
+    }
+
     /// Tries the best flip touching tet `t` (vertices `tv`), else smoothing of its vertices,
     /// else an insertion around it or the deletion of one of its vertices, whichever is
-    /// better. Returns the tets made or moved (empty: nothing changed them) and whether a
-    /// vertex was skipped for its per-pass smoothing cap.
+    /// better, using the plans made `ahead` that are still valid. Returns the tets made or
+    /// moved (empty: nothing changed them) and whether a vertex was skipped for its per-pass
+    /// smoothing cap.
     fn work_on(
         &mut self,
         t: u32,
         tv: [u32; 4],
         smoothings: &mut Vec<u8>,
         st: &mut PassState,
+        mut ahead: batch::Ahead,
     ) -> (Vec<u32>, bool) {
         let t0 = std::time::Instant::now();
-        let plan = self.best_plan(t);
+        let plan = self.use_plan(ahead.flip.take(), |im| im.best_plan(t));
         self.stats.seconds_plans += t0.elapsed().as_secs_f64();
         if let Some(plan) = plan {
             // (A flat tet flipped off its facet makes no tet: `t` is gone all the same.)
@@ -359,7 +465,7 @@ impl Improver<'_> {
             return (touched, false);
         }
         let mut capped = false;
-        for v in tv {
+        for (k, v) in tv.into_iter().enumerate() {
             if smoothings[v as usize] >= MAX_SMOOTHINGS {
                 capped = true;
                 continue;
@@ -367,7 +473,8 @@ impl Improver<'_> {
             smoothings[v as usize] += 1;
             self.stats.smooth_attempts += 1;
             let t0 = std::time::Instant::now();
-            let ok = self.smooth(v);
+            let s = self.use_plan(ahead.smooth[k].take(), |im| im.plan_smoothing(v));
+            let ok = self.apply_smoothing(v, s);
             self.stats.seconds_smooth += t0.elapsed().as_secs_f64();
             if ok {
                 let touched = self.w.star[v as usize].clone();
@@ -378,8 +485,8 @@ impl Improver<'_> {
         if capped {
             return (vec![], true);
         }
-        let insertion = self.plan_insertion(t);
-        let deletion = self.plan_deletion(t);
+        let insertion = self.use_plan(ahead.insertion.take(), |im| im.plan_insertion(t));
+        let deletion = self.use_plan(ahead.deletion.take(), |im| im.plan_deletion(t));
         let touched = match (insertion, deletion) {
             (Some(i), Some(d)) if d.new_min > i.new_min => self.apply_deletion(d),
             (Some(i), _) => self.apply_insertion(i),

@@ -117,8 +117,7 @@ fn improver_for(mesh: &TetMesh) -> Improver<'static> {
         normals: vec![],
         slide: None,
         stats: ImproveStats::default(),
-        rho_vetoes: Default::default(),
-        rho_yields: Default::default(),
+        counts: Default::default(),
     }
 }
 
@@ -404,8 +403,7 @@ fn insertion_lifts_a_flat_tet_off_a_fold() {
         normals,
         slide: None,
         stats: ImproveStats::default(),
-        rho_vetoes: Default::default(),
-        rho_yields: Default::default(),
+        counts: Default::default(),
     };
     let plan = im.plan_insertion(0).expect("an insertion");
     let made = im.apply_insertion(plan);
@@ -454,8 +452,7 @@ fn deletion_removes_a_vertex_squeezed_against_a_face() {
         normals,
         slide: None,
         stats: ImproveStats::default(),
-        rho_vetoes: Default::default(),
-        rho_yields: Default::default(),
+        counts: Default::default(),
     };
     let worst = (0..4u32)
         .min_by(|&a, &b| im.w.q[a as usize].total_cmp(&im.w.q[b as usize]))

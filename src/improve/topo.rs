@@ -1,6 +1,7 @@
 //! The improver's working mesh: tets in slots (a free list keeps ids stable and reuse
 //! deterministic), vertex stars, boundary triangles by sorted key, and the rings around edges.
 
+use super::batch::note;
 use super::quality::Objective;
 use crate::geom::orient3d;
 use crate::mesh::TetMesh;
@@ -47,6 +48,11 @@ pub(crate) struct Work {
     /// where refinement did not meet the bound (next to small input angles), changes touching
     /// them are not held to it.
     pub rho_exempt: Vec<bool>,
+    /// Per vertex: the batch (`epoch`) in which a change last marked it (`touch`), so that a
+    /// plan made at the start of the batch is known to be still the plan (`batch`).
+    changed_at: Vec<u32>,
+    /// The current batch.
+    pub epoch: u32,
 }
 
 /// What the radius-edge bound says of a change (`Work::keeps_rho`).
@@ -115,6 +121,8 @@ impl Work {
             deleted: vec![],
             rho_limit: f64::INFINITY,
             rho_exempt: vec![],
+            changed_at: vec![0; n],
+            epoch: 0,
         };
         let mut degree = vec![0u32; n];
         mesh.tets
@@ -141,6 +149,19 @@ impl Work {
             }
         }
         w
+    }
+
+    /// Marks vertex `v` as changed in this batch (its star, position, constraint or boundary
+    /// triangles, or the objective of a tet around it).
+    #[inline]
+    pub fn touch(&mut self, v: u32) {
+        self.changed_at[v as usize] = self.epoch;
+    }
+
+    /// Whether no change has marked `v` in this batch.
+    #[inline]
+    pub fn unchanged(&self, v: u32) -> bool {
+        self.changed_at[v as usize] != self.epoch
     }
 
     pub fn p(&self, v: u32) -> DVec3 {
@@ -249,6 +270,7 @@ impl Work {
         };
         for v in t {
             self.star[v as usize].push(id);
+            self.touch(v);
         }
         id
     }
@@ -258,6 +280,7 @@ impl Work {
         self.pos.push(x);
         self.star.push(Vec::new());
         self.bstar.push(Vec::new());
+        self.changed_at.push(self.epoch);
         (self.pos.len() - 1) as u32
     }
 
@@ -268,6 +291,7 @@ impl Work {
             if let Some(k) = s.iter().position(|&x| x == id) {
                 s.swap_remove(k);
             }
+            self.touch(v);
         }
         self.alive[id as usize] = false;
         self.free.push(id);
@@ -286,11 +310,13 @@ impl Work {
             if let Some(k) = s.iter().position(|&x| x == i) {
                 s.swap_remove(k);
             }
+            self.touch(v);
         }
         self.btri[i as usize] = f;
         self.bmap.insert(key3(f), i);
         for v in f {
             self.bstar[v as usize].push(i);
+            self.touch(v);
         }
     }
 
@@ -304,6 +330,7 @@ impl Work {
     /// cycle or one path (a broken input).
     pub fn ring(&self, a: u32, b: u32) -> Option<Ring> {
         // (x, y, tet) with (a, b, x, y) positively ordered.
+        note(&[a, b]);
         let mut links: Vec<(u32, u32, u32)> = Vec::with_capacity(12);
         let (sa, sb) = (&self.star[a as usize], &self.star[b as usize]);
         for &t in if sa.len() <= sb.len() { sa } else { sb } {
@@ -311,6 +338,7 @@ impl Work {
             if !(tv.contains(&b) && tv.contains(&a)) {
                 continue;
             }
+            note(tv);
             let mut o = tv.iter().copied().filter(|&v| v != a && v != b);
             let (x, y) = (o.next()?, o.next()?);
             if even_perm(tv, [a, b, x, y]) {
@@ -360,9 +388,11 @@ impl Work {
     pub fn face_tets(&self, f: [u32; 3]) -> ([u32; 2], usize) {
         let mut out = [DEAD; 2];
         let mut n = 0;
+        note(&f);
         for &t in &self.star[f[0] as usize] {
             let tv = &self.tets[t as usize];
             if tv.contains(&f[1]) && tv.contains(&f[2]) {
+                note(tv);
                 if n < 2 {
                     out[n] = t;
                 }
@@ -381,6 +411,7 @@ impl Work {
         self.flat_edges = FxHashSet::default();
         self.q = Vec::new();
         self.rho_exempt = Vec::new();
+        self.changed_at = Vec::new();
         self.free = Vec::new();
         self.to_mesh()
     }

@@ -1,0 +1,139 @@
+//! The improver's batches: the next tets of a pass are planned on the run's threads against
+//! the mesh as it stands, then committed one by one in heap order on the calling thread.
+//!
+//! Every plan (a tet's best flip, the smoothing of one of its vertices, an insertion or a
+//! deletion around it) is a pure function of the working mesh. While it is computed on a
+//! pool thread it records its footprint: every vertex whose star it scanned and every vertex
+//! of every tet it read (`note`, called by `Work::ring`, `Work::face_tets` and the planners
+//! that walk a star). Every change of the mesh marks vertices (`Work::touch`): the four
+//! vertices of every tet it kills or makes, a moved vertex, a vertex whose constraint changes,
+//! the corners of a boundary triangle it replaces. Whatever a plan read can only change through
+//! a change that marks a vertex of its footprint:
+//!
+//! - a star changes only when a tet holding its vertex comes or goes (that vertex is marked);
+//! - a tet's vertices, region and objective change only when it is killed or made, or when one
+//!   of its vertices moves (a tet read has its four vertices in the footprint);
+//! - a face or an edge changes boundary status only in a boundary flip, which kills and makes
+//!   tets holding all its vertices.
+//!
+//! So a speculative plan whose footprint holds no vertex marked since the batch began is the
+//! plan the same code would compute now, bit for bit: the commit uses it, and otherwise
+//! computes the plan again on the calling thread. The commit therefore makes exactly the
+//! changes a serial run of the batch would make, whichever plans the threads made and however
+//! many threads there were; with one thread nothing is planned ahead.
+
+use super::flips::Plan;
+use super::{delete::Deletion, insert::Insertion, smooth::Smoothing};
+use rayon::prelude::*;
+use std::cell::{Cell, RefCell};
+
+/// Tets a batch takes from the heap at most: fixed, so the order of work (and the mesh) is the
+/// same for every thread count; large enough to keep the threads busy, small enough that few
+/// plans of a batch overlap the changes committed before them.
+pub(crate) const BATCH: usize = 256;
+
+thread_local! {
+    /// The footprint being recorded on this thread, if any.
+    static FOOTPRINT: RefCell<Option<Vec<u32>>> = const { RefCell::new(None) };
+    /// Radius-edge refusals and give-ways counted by the plan running on this thread.
+    static TALLY: Cell<Tally> = const { Cell::new(Tally { vetoes: 0, yields: 0 }) };
+}
+
+/// What the radius-edge bound did during one plan (`ImproveStats::rho_vetoes`, `rho_yields`):
+/// added to the stats when the plan is used, so discarded speculation counts nothing.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Tally {
+    pub vetoes: usize,
+    pub yields: usize,
+}
+
+/// Counts a refusal (true) or a give-way (false) for the plan running on this thread.
+pub(crate) fn count_rho(vetoed: bool) {
+    TALLY.with(|c| {
+        let mut t = c.get();
+        if vetoed {
+            t.vetoes += 1;
+        } else {
+            t.yields += 1;
+        }
+        c.set(t);
+    });
+}
+
+/// Adds `vertices` to the footprint being recorded on this thread (none: nothing).
+#[inline]
+pub(crate) fn note(vertices: &[u32]) {
+    FOOTPRINT.with(|f| {
+        if let Some(foot) = f.borrow_mut().as_mut() {
+            foot.extend_from_slice(vertices);
+        }
+    });
+}
+
+/// `f()` with the radius-edge tally it made.
+pub(crate) fn tallied<T>(f: impl FnOnce() -> T) -> (T, Tally) {
+    let before = TALLY.with(|c| c.replace(Tally::default()));
+    let value = f();
+    let tally = TALLY.with(|c| c.replace(before));
+    (value, tally)
+}
+
+/// A plan computed ahead, with what it read and what the radius-edge bound did.
+pub(crate) struct Memo<T> {
+    pub value: T,
+    pub footprint: Vec<u32>,
+    pub tally: Tally,
+}
+
+/// `f()` as a [`Memo`]: its footprint starts with `start` (the vertices the caller read).
+pub(crate) fn recorded<T>(start: &[u32], f: impl FnOnce() -> T) -> Memo<T> {
+    let previous = FOOTPRINT.with(|c| c.replace(Some(start.to_vec())));
+    let (value, tally) = tallied(f);
+    let footprint = FOOTPRINT.with(|c| c.replace(previous)).unwrap_or_default();
+    Memo {
+        value,
+        footprint,
+        tally,
+    }
+}
+
+/// The plans made ahead for one tet of a batch, in the order `Improver::work_on` asks for
+/// them (a plan it would not reach on the mesh as it stood is left out).
+#[derive(Default)]
+pub(crate) struct Ahead {
+    pub flip: Option<Memo<Option<Plan>>>,
+    /// The smoothing of each of the tet's vertices, in the tet's vertex order.
+    pub smooth: [Option<Memo<Smoothing>>; 4],
+    pub insertion: Option<Memo<Option<Insertion>>>,
+    pub deletion: Option<Memo<Option<Deletion>>>,
+}
+
+/// How the plans made ahead fared at the commit (reported with `SLIVERMESH_IMPROVE_BATCHES`).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Counts {
+    pub batches: usize,
+    pub entries: usize,
+    /// Plans used as made ahead, and made again because a change touched their footprint.
+    pub used: usize,
+    pub replanned: usize,
+    /// Plans the commit needed that were not made ahead.
+    pub unplanned: usize,
+}
+
+/// `items.iter().map(f).collect()` on the run's threads (`crate::parallel::install`), in
+/// order. Unlike `crate::parallel::map_collect` it splits short slices: a batch has a few
+/// hundred items, each worth tens of microseconds. Each value depends on its own item only.
+pub(crate) fn map_in_order<T: Sync, U: Send>(
+    items: &[T],
+    f: impl Fn(&T) -> U + Sync + Send,
+) -> Vec<U> {
+    let mut out = Vec::with_capacity(items.len());
+    crate::parallel::install(|| {
+        items
+            .par_iter()
+            .with_max_len(4)
+            .map(f)
+            .collect_into_vec(&mut out)
+    });
+    out
+}
