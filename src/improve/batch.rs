@@ -87,9 +87,15 @@ pub(crate) struct Memo<T> {
 
 /// `f()` as a [`Memo`]: its footprint starts with `start` (the vertices the caller read).
 pub(crate) fn recorded<T>(start: &[u32], f: impl FnOnce() -> T) -> Memo<T> {
-    let previous = FOOTPRINT.with(|c| c.replace(Some(start.to_vec())));
+    let mut foot = Vec::with_capacity(256);
+    foot.extend_from_slice(start);
+    let previous = FOOTPRINT.with(|c| c.replace(Some(foot)));
     let (value, tally) = tallied(f);
-    let footprint = FOOTPRINT.with(|c| c.replace(previous)).unwrap_or_default();
+    let mut footprint = FOOTPRINT.with(|c| c.replace(previous)).unwrap_or_default();
+    // Each vertex once: the commit checks them on the calling thread.
+    footprint.sort_unstable();
+    footprint.dedup();
+    footprint.shrink_to_fit();
     Memo {
         value,
         footprint,
@@ -113,6 +119,8 @@ pub(crate) struct Ahead {
 pub(crate) struct Counts {
     pub batches: usize,
     pub entries: usize,
+    /// Of which still due at the commit.
+    pub worked: usize,
     /// Plans used as made ahead, and made again because a change touched their footprint.
     pub used: usize,
     pub replanned: usize,

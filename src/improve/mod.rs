@@ -358,6 +358,7 @@ impl Improver<'_> {
                 if !self.due(t, tv, target, improve, st) {
                     continue;
                 }
+                self.counts.worked += 1;
                 let ahead = plans.get_mut(k).map(std::mem::take).unwrap_or_default();
                 let (touched, capped) = self.work_on(t, tv, &mut smoothings, st, ahead);
                 if st.tried.len() < self.w.tets.len() {

@@ -100,6 +100,36 @@ pub(crate) fn even_perm(t: &[u32; 4], p: [u32; 4]) -> bool {
     inv % 2 == 0
 }
 
+/// Puts every tet id into the stars of its vertices, in id order (as `Work::push_tet` would
+/// one tet after the other). On the run's threads: each takes a range of vertices and scans
+/// all the tets for them, so every star gets the same ids in the same order whatever the
+/// thread count. The stars already hold the room they need (nothing is allocated here: a
+/// star allocated on a pool thread would live in that thread's heap).
+fn fill_stars(star: &mut [Vec<u32>], tets: &[[u32; 4]]) {
+    let fill = |lo: usize, stars: &mut [Vec<u32>]| {
+        let hi = lo + stars.len();
+        for (i, t) in tets.iter().enumerate() {
+            for &v in t {
+                let v = v as usize;
+                if (lo..hi).contains(&v) {
+                    stars[v - lo].push(i as u32);
+                }
+            }
+        }
+    };
+    let threads = crate::parallel::current_threads();
+    if threads <= 1 || tets.len() < 1 << 16 {
+        return fill(0, star);
+    }
+    let chunk = star.len().div_ceil(threads);
+    crate::parallel::install(|| {
+        use rayon::prelude::*;
+        star.par_chunks_mut(chunk)
+            .enumerate()
+            .for_each(|(k, s)| fill(k * chunk, s));
+    });
+}
+
 impl Work {
     pub fn new(mesh: &TetMesh, objective: Objective) -> Work {
         let n = mesh.vertices.len();
@@ -134,13 +164,15 @@ impl Work {
         }
         // The tets' objectives on the run's threads (`crate::parallel`, in tet order).
         let pos = &w.pos;
-        let qs = crate::parallel::map_collect(&mesh.tets, |t| {
+        w.q = crate::parallel::map_collect(&mesh.tets, |t| {
             let [a, b, c, d] = t.map(|v| pos[v as usize]);
             objective.of(a, b, c, d)
         });
-        for (i, (&t, q)) in mesh.tets.iter().zip(qs).enumerate() {
-            w.push_tet(t, mesh.tet_regions.get(i).copied().unwrap_or(0), q);
-        }
+        w.tets.extend_from_slice(&mesh.tets);
+        w.region
+            .extend((0..mesh.tets.len()).map(|i| mesh.tet_regions.get(i).copied().unwrap_or(0)));
+        w.alive.resize(mesh.tets.len(), true);
+        fill_stars(&mut w.star, &mesh.tets);
         w.bmap.reserve(mesh.boundary.len());
         for (i, &f) in mesh.boundary.iter().enumerate() {
             w.bmap.insert(key3(f), i as u32);
@@ -182,10 +214,12 @@ impl Work {
             return;
         }
         let mut over = vec![false; self.pos.len()];
+        // The tets' ratios on the run's threads (`crate::parallel`; dead slots are skipped).
+        let rho_over =
+            crate::parallel::map_collect(&self.tets, |t| Self::rho_at(self.points(t)) > limit);
         for t in 0..self.tets.len() {
-            let tv = self.tets[t];
-            if self.alive[t] && Self::rho_at(self.points(&tv)) > limit {
-                tv.iter().for_each(|&v| over[v as usize] = true);
+            if self.alive[t] && rho_over[t] {
+                self.tets[t].iter().for_each(|&v| over[v as usize] = true);
             }
         }
         // And the tets around those vertices: the changes that fix a bad tet there reach one
