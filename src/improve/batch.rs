@@ -107,6 +107,8 @@ pub(crate) fn recorded<T>(start: &[u32], f: impl FnOnce() -> T) -> Memo<T> {
 /// them (a plan it would not reach on the mesh as it stood is left out).
 #[derive(Default)]
 pub(crate) struct Ahead {
+    /// The batch they were made in (`Work::epoch`).
+    pub epoch: u32,
     pub flip: Option<Memo<Option<Plan>>>,
     /// The smoothing of each of the tet's vertices, in the tet's vertex order.
     pub smooth: [Option<Memo<Smoothing>>; 4],
@@ -119,8 +121,6 @@ pub(crate) struct Ahead {
 pub(crate) struct Counts {
     pub batches: usize,
     pub entries: usize,
-    /// Of which still due at the commit.
-    pub worked: usize,
     /// Plans used as made ahead, and made again because a change touched their footprint.
     pub used: usize,
     pub replanned: usize,

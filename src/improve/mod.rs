@@ -38,6 +38,7 @@ use crate::run::params::{Params, SurfaceMode};
 use crate::run::report::ImproveStats;
 use constraints::Constraint;
 use glam::DVec3;
+use rustc_hash::FxHashMap;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 use topo::Work;
@@ -115,6 +116,9 @@ const CLIMB_LIMIT_DEG: f64 = 45.0;
 
 /// Smoothings of one vertex per pass at most (each must gain, but gains can be small).
 const MAX_SMOOTHINGS: u8 = 2;
+
+/// A heap entry: the tet's objective (`key`), slot and vertices.
+type Entry = (u64, u32, [u32; 4]);
 
 /// Total order key of an objective value (worst first out of a max-heap of `Reverse`).
 fn key(q: f64) -> u64 {
@@ -297,14 +301,14 @@ impl Improver<'_> {
     /// One pass over the tets below `target` (or only the flat and inverted ones when not
     /// `improve`), worst first; returns the number of changes.
     ///
-    /// The heap is taken in batches of at most `batch::BATCH` due tets. With several threads
-    /// each batch's plans are made ahead on the run's threads, against the mesh as the batch
-    /// begins; then, on this thread and in heap order, each tet still due is worked on
-    /// (`work_on`) with the plans made ahead that no earlier change of the batch touched. The
-    /// tets a change makes or moves go back on the heap for a later batch.
+    /// With several threads, the plans are made ahead in batches (`batch`): when the tet
+    /// taken from the heap has none, the next `batch::BATCH` due tets of the heap get theirs on
+    /// the run's threads, against the mesh as it stands. The tets are still taken and worked on
+    /// one at a time in heap order, and a plan made ahead is used only where it is the one
+    /// `work_on` would make now, so the changes are those of the serial loop.
     fn pass(&mut self, target: f64, improve: bool, st: &mut PassState) -> usize {
         self.stats.passes += 1;
-        let mut heap: BinaryHeap<Reverse<(u64, u32, [u32; 4])>> = BinaryHeap::new();
+        let mut heap: BinaryHeap<Reverse<Entry>> = BinaryHeap::new();
         for t in 0..self.w.tets.len() as u32 {
             if self.w.alive[t as usize] && self.bad(t, target, improve) {
                 heap.push(Reverse((
@@ -315,83 +319,103 @@ impl Improver<'_> {
             }
         }
         let ahead = crate::parallel::current_threads() > 1;
+        let mut planned: FxHashMap<(u32, [u32; 4]), batch::Ahead> = FxHashMap::default();
+        // The last entry the latest batch looked at: a later entry without plans starts the
+        // next batch, an earlier one (made since) is planned when worked on.
+        let mut horizon: Option<Entry> = None;
         let mut changes = 0;
         let mut smoothings = vec![0u8; self.w.pos.len()];
-        // Per tet slot: the last batch that took it (a tet pushed twice goes in once).
-        let mut taken: Vec<u32> = vec![0; self.w.tets.len()];
-        let mut batch: Vec<(u32, [u32; 4])> = Vec::with_capacity(batch::BATCH);
-        while changes < st.budget {
-            self.w.epoch += 1;
-            let epoch = self.w.epoch;
-            batch.clear();
-            while batch.len() < batch::BATCH {
-                let Some(Reverse((_, t, tv))) = heap.pop() else {
-                    break;
-                };
-                if taken.len() < self.w.tets.len() {
-                    taken.resize(self.w.tets.len(), 0);
-                }
-                if taken[t as usize] != epoch && self.due(t, tv, target, improve, st) {
-                    taken[t as usize] = epoch;
-                    batch.push((t, tv));
-                }
-            }
-            if batch.is_empty() {
+        while let Some(Reverse(entry)) = heap.pop() {
+            if changes >= st.budget {
                 break;
             }
-            self.counts.batches += 1;
-            self.counts.entries += batch.len();
-            let mut plans: Vec<batch::Ahead> = if ahead {
-                let t0 = std::time::Instant::now();
-                let (this, smoothings) = (&*self, &smoothings);
-                let plans =
-                    batch::map_in_order(&batch, |&(t, tv)| this.plan_ahead(t, tv, smoothings));
-                self.stats.seconds_plans += t0.elapsed().as_secs_f64();
-                plans
-            } else {
-                vec![]
-            };
-            for (k, &(t, tv)) in batch.iter().enumerate() {
-                if changes >= st.budget {
-                    break;
+            let (_, t, tv) = entry;
+            let mut plans = planned.remove(&(t, tv));
+            if !self.due(t, tv, target, improve, st) {
+                continue;
+            }
+            if ahead && plans.is_none() && horizon.is_none_or(|h| entry > h) {
+                heap.push(Reverse(entry));
+                horizon =
+                    self.plan_batch(&mut heap, &mut planned, &smoothings, target, improve, st);
+                heap.pop();
+                plans = planned.remove(&(t, tv));
+            }
+            let (touched, capped) =
+                self.work_on(t, tv, &mut smoothings, st, plans.unwrap_or_default());
+            if st.tried.len() < self.w.tets.len() {
+                st.tried.resize(self.w.tets.len(), 0);
+            }
+            if touched.is_empty() {
+                if !capped {
+                    st.tried[t as usize] = st.clock;
                 }
-                if !self.due(t, tv, target, improve, st) {
-                    continue;
-                }
-                self.counts.worked += 1;
-                let ahead = plans.get_mut(k).map(std::mem::take).unwrap_or_default();
-                let (touched, capped) = self.work_on(t, tv, &mut smoothings, st, ahead);
-                if st.tried.len() < self.w.tets.len() {
-                    st.tried.resize(self.w.tets.len(), 0);
-                }
-                if touched.is_empty() {
-                    if !capped {
-                        st.tried[t as usize] = st.clock;
-                    }
-                    continue;
-                }
-                changes += 1;
-                for n in touched {
-                    st.tried[n as usize] = 0;
-                    if self.bad(n, target, improve) {
-                        heap.push(Reverse((
-                            key(self.w.q[n as usize]),
-                            n,
-                            self.w.tets[n as usize],
-                        )));
-                    }
+                continue;
+            }
+            changes += 1;
+            for n in touched {
+                st.tried[n as usize] = 0;
+                if self.bad(n, target, improve) {
+                    heap.push(Reverse((
+                        key(self.w.q[n as usize]),
+                        n,
+                        self.w.tets[n as usize],
+                    )));
                 }
             }
         }
         changes
+    }
+
+    /// Makes the plans of the next `batch::BATCH` due entries of `heap` that have none, on the
+    /// run's threads, into `planned`; the heap is left as it was. Returns the last entry
+    /// looked at.
+    fn plan_batch(
+        &mut self,
+        heap: &mut BinaryHeap<Reverse<Entry>>,
+        planned: &mut FxHashMap<(u32, [u32; 4]), batch::Ahead>,
+        smoothings: &[u8],
+        target: f64,
+        improve: bool,
+        st: &PassState,
+    ) -> Option<Entry> {
+        let t0 = std::time::Instant::now();
+        let mut seen: Vec<Entry> = Vec::with_capacity(batch::BATCH);
+        let mut batch: Vec<(u32, [u32; 4])> = Vec::with_capacity(batch::BATCH);
+        while batch.len() < batch::BATCH && seen.len() < 4 * batch::BATCH {
+            let Some(Reverse(e)) = heap.pop() else {
+                break;
+            };
+            seen.push(e);
+            let (_, t, tv) = e;
+            if !planned.contains_key(&(t, tv)) && self.due(t, tv, target, improve, st) {
+                batch.push((t, tv));
+            }
+        }
+        let horizon = seen.last().copied();
+        heap.extend(seen.into_iter().map(Reverse));
+        // (A tet in the heap twice is planned once.)
+        batch.sort_unstable();
+        batch.dedup();
+        self.w.epoch += 1;
+        let epoch = self.w.epoch;
+        let this = &*self;
+        let plans =
+            batch::map_in_order(&batch, |&(t, tv)| this.plan_ahead(t, tv, smoothings, epoch));
+        self.counts.batches += 1;
+        self.counts.entries += batch.len();
+        planned.extend(batch.into_iter().zip(plans));
+        self.stats.seconds_plans += t0.elapsed().as_secs_f64();
+        horizon
     }
 }
 
 impl Improver<'_> {
     /// The plans `work_on` would ask for on tet `t` (vertices `tv`) if the mesh stayed as it
     /// is, each with its footprint (`batch`); only reads the mesh.
-    fn plan_ahead(&self, t: u32, tv: [u32; 4], smoothings: &[u8]) -> batch::Ahead {
+    fn plan_ahead(&self, t: u32, tv: [u32; 4], smoothings: &[u8], epoch: u32) -> batch::Ahead {
         let mut ahead = batch::Ahead {
+            epoch,
             flip: Some(batch::recorded(&tv, || self.best_plan(t))),
             ..Default::default()
         };
@@ -420,9 +444,18 @@ impl Improver<'_> {
 
     /// `ahead`'s value if no change of this batch touched its footprint, else `plan()` made
     /// now: the same value either way. The radius-edge tally of the one used is counted.
-    fn use_plan<T>(&mut self, ahead: Option<batch::Memo<T>>, plan: impl FnOnce(&Self) -> T) -> T {
+    fn use_plan<T>(
+        &mut self,
+        ahead: Option<batch::Memo<T>>,
+        epoch: u32,
+        plan: impl FnOnce(&Self) -> T,
+    ) -> T {
         let (value, tally) = match ahead {
-            Some(m) if m.footprint.iter().all(|&v| self.w.unchanged(v)) => {
+            Some(m)
+                if m.footprint
+                    .iter()
+                    .all(|&v| self.w.unchanged_since(v, epoch)) =>
+            {
                 self.counts.used += 1;
                 (m.value, m.tally)
             }
@@ -454,7 +487,7 @@ impl Improver<'_> {
         mut ahead: batch::Ahead,
     ) -> (Vec<u32>, bool) {
         let t0 = std::time::Instant::now();
-        let plan = self.use_plan(ahead.flip.take(), |im| im.best_plan(t));
+        let plan = self.use_plan(ahead.flip.take(), ahead.epoch, |im| im.best_plan(t));
         self.stats.seconds_plans += t0.elapsed().as_secs_f64();
         if let Some(plan) = plan {
             // (A flat tet flipped off its facet makes no tet: `t` is gone all the same.)
@@ -474,7 +507,9 @@ impl Improver<'_> {
             smoothings[v as usize] += 1;
             self.stats.smooth_attempts += 1;
             let t0 = std::time::Instant::now();
-            let s = self.use_plan(ahead.smooth[k].take(), |im| im.plan_smoothing(v));
+            let s = self.use_plan(ahead.smooth[k].take(), ahead.epoch, |im| {
+                im.plan_smoothing(v)
+            });
             let ok = self.apply_smoothing(v, s);
             self.stats.seconds_smooth += t0.elapsed().as_secs_f64();
             if ok {
@@ -486,8 +521,10 @@ impl Improver<'_> {
         if capped {
             return (vec![], true);
         }
-        let insertion = self.use_plan(ahead.insertion.take(), |im| im.plan_insertion(t));
-        let deletion = self.use_plan(ahead.deletion.take(), |im| im.plan_deletion(t));
+        let insertion = self.use_plan(ahead.insertion.take(), ahead.epoch, |im| {
+            im.plan_insertion(t)
+        });
+        let deletion = self.use_plan(ahead.deletion.take(), ahead.epoch, |im| im.plan_deletion(t));
         let touched = match (insertion, deletion) {
             (Some(i), Some(d)) if d.new_min > i.new_min => self.apply_deletion(d),
             (Some(i), _) => self.apply_insertion(i),

@@ -190,10 +190,10 @@ impl Work {
         self.changed_at[v as usize] = self.epoch;
     }
 
-    /// Whether no change has marked `v` in this batch.
+    /// Whether no change has marked `v` since batch `epoch` began.
     #[inline]
-    pub fn unchanged(&self, v: u32) -> bool {
-        self.changed_at[v as usize] != self.epoch
+    pub fn unchanged_since(&self, v: u32, epoch: u32) -> bool {
+        self.changed_at[v as usize] < epoch
     }
 
     pub fn p(&self, v: u32) -> DVec3 {
