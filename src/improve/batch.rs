@@ -41,7 +41,7 @@ thread_local! {
 
 /// What the radius-edge bound did during one plan (`ImproveStats::rho_vetoes`, `rho_yields`):
 /// added to the stats when the plan is used, so discarded speculation counts nothing.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct Tally {
     pub vetoes: usize,
     pub yields: usize,

@@ -18,6 +18,7 @@ use super::Improver;
 const MAX_STAR: usize = 64;
 
 /// A planned deletion, applied by [`Improver::apply_deletion`].
+#[derive(Debug, PartialEq)]
 pub(crate) struct Deletion {
     v: u32,
     kill: Vec<u32>,

@@ -444,11 +444,13 @@ impl Improver<'_> {
 
     /// `ahead`'s value if no change of this batch touched its footprint, else `plan()` made
     /// now: the same value either way. The radius-edge tally of the one used is counted.
-    fn use_plan<T>(
+    /// (The unit tests make every plan used again and compare: a footprint that misses what
+    /// a plan read fails them.)
+    fn use_plan<T: PartialEq + std::fmt::Debug>(
         &mut self,
         ahead: Option<batch::Memo<T>>,
         epoch: u32,
-        plan: impl FnOnce(&Self) -> T,
+        plan: impl Fn(&Self) -> T,
     ) -> T {
         let (value, tally) = match ahead {
             Some(m)
@@ -457,6 +459,11 @@ impl Improver<'_> {
                     .all(|&v| self.w.unchanged_since(v, epoch)) =>
             {
                 self.counts.used += 1;
+                if cfg!(test) {
+                    let again = batch::tallied(|| plan(self));
+                    assert_eq!(again.0, m.value, "a plan made ahead went stale");
+                    assert_eq!(again.1, m.tally, "a plan made ahead went stale");
+                }
                 (m.value, m.tally)
             }
             ahead => {

@@ -468,3 +468,94 @@ fn deletion_removes_a_vertex_squeezed_against_a_face() {
     assert_eq!(out.tet_regions, vec![7]);
     check_no_degenerate(&out).unwrap();
 }
+
+/// The refinement's mesh of shared model `rel` (keep mode, unimproved) and its input.
+fn refined_model(rel: &str, threads: usize) -> (TetMesh, PlcInput) {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("models")
+        .join(rel);
+    let read = crate::io::ReadOptions {
+        merge_coplanar: rel.ends_with(".off"),
+    };
+    let input = crate::io::read_plc(&path, &read).unwrap();
+    let params = Params {
+        surface_mode: SurfaceMode::Keep,
+        improve: false,
+        threads,
+        ..Params::default()
+    };
+    let mesh = crate::pipeline::mesh(&input, &params, None, None)
+        .unwrap()
+        .0;
+    (mesh, input)
+}
+
+/// On several threads the plans are made ahead in batches; in this build every plan used as
+/// made ahead is made again and compared (`Improver::use_plan`), so a footprint that misses
+/// something a plan read fails here. The meshes and counts match the one-thread run's.
+#[test]
+fn plans_made_ahead_are_the_plans_made_now() {
+    let untimed = |s: &ImproveStats| ImproveStats {
+        seconds: 0.0,
+        seconds_plans: 0.0,
+        seconds_smooth: 0.0,
+        ..s.clone()
+    };
+    for (rel, opts) in [
+        ("off/joint.off", Options::default()),
+        // Higher target, radius-edge bound kept: smoothing, insertion, deletion and vetoes.
+        (
+            "poly/tetgen_example.poly",
+            Options {
+                target_deg: 32.0,
+                keep_rho: 2.0,
+                ..Options::default()
+            },
+        ),
+        (
+            "off/part.off",
+            Options {
+                target_deg: 30.0,
+                keep_rho: 2.0,
+                ..Options::default()
+            },
+        ),
+    ] {
+        let (mesh, input) = refined_model(rel, 1);
+        let run = |threads| {
+            crate::parallel::with_threads(threads, || improve(&mesh, Some(&input), &opts))
+        };
+        let (want, stats) = run(1);
+        assert!(stats.changed(), "{rel}");
+        for threads in [2, 3] {
+            let (got, s) = run(threads);
+            assert!(
+                got == want,
+                "{rel}: the mesh differs with {threads} threads"
+            );
+            assert_eq!(untimed(&s), untimed(&stats), "{rel}: {threads} threads");
+        }
+    }
+}
+
+/// The same in approximate mode, where boundary vertices slide on the input surface.
+#[test]
+fn plans_made_ahead_while_sliding() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models/off/fandisk.off");
+    let read = crate::io::ReadOptions {
+        merge_coplanar: true,
+    };
+    let input = crate::io::read_plc(&path, &read).unwrap();
+    let run = |threads| {
+        let params = Params {
+            surface_mode: SurfaceMode::Approximate,
+            threads,
+            ..Params::default()
+        };
+        let (mesh, _, report) = crate::pipeline::mesh(&input, &params, None, None).unwrap();
+        (mesh, report.improvement.smoothed)
+    };
+    let (want, smoothed) = run(1);
+    assert!(smoothed > 0);
+    assert!(run(2) == (want, smoothed));
+}

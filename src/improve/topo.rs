@@ -217,9 +217,9 @@ impl Work {
         // The tets' ratios on the run's threads (`crate::parallel`; dead slots are skipped).
         let rho_over =
             crate::parallel::map_collect(&self.tets, |t| Self::rho_at(self.points(t)) > limit);
-        for t in 0..self.tets.len() {
-            if self.alive[t] && rho_over[t] {
-                self.tets[t].iter().for_each(|&v| over[v as usize] = true);
+        for ((tv, &alive), &high) in self.tets.iter().zip(&self.alive).zip(&rho_over) {
+            if alive && high {
+                tv.iter().for_each(|&v| over[v as usize] = true);
             }
         }
         // And the tets around those vertices: the changes that fix a bad tet there reach one
