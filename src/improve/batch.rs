@@ -1,36 +1,52 @@
-//! The improver's batches: the next tets of a pass are planned on the run's threads against
-//! the mesh as it stands, then committed one by one in heap order on the calling thread.
+//! Plans made ahead on the run's threads (issue 39: the same mesh for every thread count).
 //!
-//! Every plan (a tet's best flip, the smoothing of one of its vertices, an insertion or a
-//! deletion around it) is a pure function of the working mesh. While it is computed on a
-//! pool thread it records its footprint: every vertex whose star it scanned and every vertex
-//! of every tet it read (`note`, called by `Work::ring`, `Work::face_tets` and the planners
-//! that walk a star). Every change of the mesh marks vertices (`Work::touch`): the four
-//! vertices of every tet it kills or makes, a moved vertex, a vertex whose constraint changes,
-//! the corners of a boundary triangle it replaces. Whatever a plan read can only change through
-//! a change that marks a vertex of its footprint:
+//! The improver still takes the bad tets from its heap one at a time, worst first, and works
+//! on each (`Improver::work_on`) on the calling thread, exactly as with one thread. What the
+//! threads do is make, in batches, the plans it will ask for: when the tet taken from the heap
+//! has none, the next due entries of the heap (`batch_size`, the heap left as it was) are
+//! planned on the run's threads against the mesh as it stands (`Improver::plan_ahead`: the
+//! tet's best flip, else the smoothings of its vertices, else an insertion and a deletion).
+//! When `work_on` then needs a plan, it takes the one made ahead if it is still the plan it
+//! would make now, and makes it now otherwise.
+//!
+//! Whether it still is, is decided exactly. Every plan is a pure function of the working mesh
+//! (the radius-edge tally it counts included), and while it is made ahead it records its
+//! footprint: every vertex whose star it scanned and every vertex of every tet it read
+//! (`note`, called by `Work::ring`, `Work::face_tets` and the planners that walk a star, the
+//! tet's own vertices). Every change of the mesh marks vertices with the current batch
+//! (`Work::touch`): the four vertices of every tet it kills or makes, a moved vertex, a vertex
+//! whose constraint changes, the corners of a boundary triangle it replaces. What a plan reads
+//! only changes through a change that marks a vertex of its footprint:
 //!
 //! - a star changes only when a tet holding its vertex comes or goes (that vertex is marked);
 //! - a tet's vertices, region and objective change only when it is killed or made, or when one
 //!   of its vertices moves (a tet read has its four vertices in the footprint);
 //! - a face or an edge changes boundary status only in a boundary flip, which kills and makes
-//!   tets holding all its vertices.
+//!   tets holding all its vertices; a vertex's constraint (and its boundary triangles) only
+//!   when it is marked.
 //!
-//! So a speculative plan whose footprint holds no vertex marked since the batch began is the
-//! plan the same code would compute now, bit for bit: the commit uses it, and otherwise
-//! computes the plan again on the calling thread. The commit therefore makes exactly the
-//! changes a serial run of the batch would make, whichever plans the threads made and however
-//! many threads there were; with one thread nothing is planned ahead.
+//! So a plan whose footprint holds no vertex marked since its batch began is, bit for bit, the
+//! plan the same code makes now (the unit tests make every such plan again and compare). The
+//! changes, their order, the stats and the mesh are therefore those of the one-thread run,
+//! whichever plans were made ahead: the batch size, the thread count and the scheduling of the
+//! threads decide only how much planning is done twice. No hashing decides anything either
+//! (the plans made ahead are looked up by tet, never iterated).
 
 use super::flips::Plan;
 use super::{delete::Deletion, insert::Insertion, smooth::Smoothing};
 use rayon::prelude::*;
 use std::cell::{Cell, RefCell};
 
-/// Tets a batch takes from the heap at most: fixed, so the order of work (and the mesh) is the
-/// same for every thread count; large enough to keep the threads busy, small enough that few
-/// plans of a batch overlap the changes committed before them.
-pub(crate) const BATCH: usize = 256;
+/// Entries a batch plans per thread of the run. Any size gives the same mesh; larger batches
+/// keep the threads busy for longer, smaller ones leave fewer plans to go stale before they are
+/// used (rotor.off in keep mode, 2 threads: batches of 64 made 4.8% of the plans again, of
+/// 256: 11%).
+const PER_THREAD: usize = 32;
+
+/// Entries a batch plans: `PER_THREAD` per thread, at least 64.
+pub(crate) fn batch_size(threads: usize) -> usize {
+    (PER_THREAD * threads).max(64)
+}
 
 thread_local! {
     /// The footprint being recorded on this thread, if any.

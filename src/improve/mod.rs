@@ -20,6 +20,18 @@
 //! strictly raises the worst objective of the tets it replaces or moves. Passes repeat until one changes
 //! nothing or the budget is spent. Order: by objective, then tet slot; no hashing decides
 //! anything, so the result is deterministic.
+//!
+//! Threads (`batch`): the driver stays serial (one tet at a time, in heap order, on the
+//! calling thread), but the plans it asks for, which only read the mesh (the best flip, the
+//! smoothing of a vertex, an insertion, a deletion), are made ahead in batches on the run's
+//! threads, each with its footprint (the vertices whose stars and tets it read). A plan made
+//! ahead is used only if no change since its batch began marked a vertex of its footprint,
+//! and made again otherwise: it is then bit for bit the plan the driver would make now. So the
+//! changes, their order, the stats and the mesh are those of the one-thread run for every
+//! thread count (with one thread nothing is planned ahead); the threads decide only how much
+//! planning is done twice. The working mesh's set-up (the tets' objectives and radius-edge
+//! ratios, the vertex stars) is also spread over the threads, each value depending on its own
+//! tet or vertex only.
 
 mod batch;
 mod constraints;
@@ -302,7 +314,7 @@ impl Improver<'_> {
     /// `improve`), worst first; returns the number of changes.
     ///
     /// With several threads, the plans are made ahead in batches (`batch`): when the tet
-    /// taken from the heap has none, the next `batch::BATCH` due tets of the heap get theirs on
+    /// taken from the heap has none, the next due tets of the heap get theirs on
     /// the run's threads, against the mesh as it stands. The tets are still taken and worked on
     /// one at a time in heap order, and a plan made ahead is used only where it is the one
     /// `work_on` would make now, so the changes are those of the serial loop.
@@ -367,7 +379,7 @@ impl Improver<'_> {
         changes
     }
 
-    /// Makes the plans of the next `batch::BATCH` due entries of `heap` that have none, on the
+    /// Makes the plans of the next `batch::batch_size` due entries of `heap` that have none, on the
     /// run's threads, into `planned`; the heap is left as it was. Returns the last entry
     /// looked at.
     fn plan_batch(
@@ -380,9 +392,10 @@ impl Improver<'_> {
         st: &PassState,
     ) -> Option<Entry> {
         let t0 = std::time::Instant::now();
-        let mut seen: Vec<Entry> = Vec::with_capacity(batch::BATCH);
-        let mut batch: Vec<(u32, [u32; 4])> = Vec::with_capacity(batch::BATCH);
-        while batch.len() < batch::BATCH && seen.len() < 4 * batch::BATCH {
+        let size = batch::batch_size(crate::parallel::current_threads());
+        let mut seen: Vec<Entry> = Vec::with_capacity(4 * size);
+        let mut batch: Vec<(u32, [u32; 4])> = Vec::with_capacity(size);
+        while batch.len() < size && seen.len() < 4 * size {
             let Some(Reverse(e)) = heap.pop() else {
                 break;
             };
