@@ -132,18 +132,6 @@ pub(crate) struct Ahead {
     pub deletion: Option<Memo<Option<Deletion>>>,
 }
 
-/// How the plans made ahead fared at the commit (reported with `SLIVERMESH_IMPROVE_BATCHES`).
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct Counts {
-    pub batches: usize,
-    pub entries: usize,
-    /// Plans used as made ahead, and made again because a change touched their footprint.
-    pub used: usize,
-    pub replanned: usize,
-    /// Plans the commit needed that were not made ahead.
-    pub unplanned: usize,
-}
-
 /// `items.iter().map(f).collect()` on the run's threads (`crate::parallel::install`), in
 /// order. Unlike `crate::parallel::map_collect` it splits short slices: a batch has a few
 /// hundred items, each worth tens of microseconds. Each value depends on its own item only.

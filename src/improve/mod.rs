@@ -93,21 +93,19 @@ pub(crate) struct Improver<'s> {
     /// Approximate mode: the boundary vertices that slide on the input surface, and how.
     slide: Option<&'s dyn SurfaceSlide>,
     stats: ImproveStats,
-    /// How the batches' plans made ahead fared.
-    counts: batch::Counts,
 }
 
 /// How the boundary vertices of an approximated surface may move (approximate mode): within
 /// their tangent plane, then put back on the input surface, as long as the boundary triangles
 /// around them stay close to it.
+///
+/// `Sync`: the improver plans on the run's threads (`batch`), and every answer must depend on
+/// the arguments only.
 pub trait SurfaceSlide: Sync {
     /// Whether boundary vertex `v` may move (not at a corner).
     fn slides(&self, v: u32) -> bool;
     /// For a vertex on a feature curve (at `at`): the curve's direction there (it moves along
     /// it); None for a vertex inside a patch (it moves in its tangent plane).
-    ///
-    /// `Sync`: the improver plans on the run's threads (`batch`); every answer must depend on its
-    /// arguments only.
     fn along(&self, v: u32, at: DVec3) -> Option<DVec3>;
     /// `x` put on the part of the input surface where `v` may lie, or None.
     fn project(&self, v: u32, x: DVec3) -> Option<DVec3>;
@@ -199,16 +197,12 @@ fn improve_work(
         normals,
         slide,
         stats: ImproveStats::default(),
-        counts: Default::default(),
     };
     im.stats.degenerate_before = (0..im.w.tets.len())
         .filter(|&t| im.w.q[t] < SURELY_POSITIVE && !im.w.positive(im.w.tets[t]))
         .count();
     if opts.improve || im.stats.degenerate_before > 0 {
         im.run(opts);
-    }
-    if std::env::var_os("SLIVERMESH_IMPROVE_BATCHES").is_some() {
-        eprintln!("improve batches: {:?}", im.counts);
     }
     im.stats.seconds = start.elapsed().as_secs_f64();
     (im.w.into_mesh(), im.stats)
@@ -313,11 +307,11 @@ impl Improver<'_> {
     /// One pass over the tets below `target` (or only the flat and inverted ones when not
     /// `improve`), worst first; returns the number of changes.
     ///
-    /// With several threads, the plans are made ahead in batches (`batch`): when the tet
-    /// taken from the heap has none, the next due tets of the heap get theirs on
-    /// the run's threads, against the mesh as it stands. The tets are still taken and worked on
-    /// one at a time in heap order, and a plan made ahead is used only where it is the one
-    /// `work_on` would make now, so the changes are those of the serial loop.
+    /// With several threads, the plans are made ahead in batches (`batch`): when the tet taken
+    /// from the heap has none, the next due tets of the heap get theirs on the run's threads,
+    /// against the mesh as it stands. The tets are still taken and worked on one at a time in
+    /// heap order, and a plan made ahead is used only where it is the one `work_on` would make
+    /// now, so the changes are those of the serial loop.
     fn pass(&mut self, target: f64, improve: bool, st: &mut PassState) -> usize {
         self.stats.passes += 1;
         let mut heap: BinaryHeap<Reverse<Entry>> = BinaryHeap::new();
@@ -379,9 +373,9 @@ impl Improver<'_> {
         changes
     }
 
-    /// Makes the plans of the next `batch::batch_size` due entries of `heap` that have none, on the
-    /// run's threads, into `planned`; the heap is left as it was. Returns the last entry
-    /// looked at.
+    /// Makes the plans of the next `batch::batch_size` due entries of `heap` that have none,
+    /// on the run's threads, into `planned`; the heap is left as it was. Returns the last
+    /// entry looked at.
     fn plan_batch(
         &mut self,
         heap: &mut BinaryHeap<Reverse<Entry>>,
@@ -415,8 +409,6 @@ impl Improver<'_> {
         let this = &*self;
         let plans =
             batch::map_in_order(&batch, |&(t, tv)| this.plan_ahead(t, tv, smoothings, epoch));
-        self.counts.batches += 1;
-        self.counts.entries += batch.len();
         planned.extend(batch.into_iter().zip(plans));
         self.stats.seconds_plans += t0.elapsed().as_secs_f64();
         horizon
@@ -425,7 +417,8 @@ impl Improver<'_> {
 
 impl Improver<'_> {
     /// The plans `work_on` would ask for on tet `t` (vertices `tv`) if the mesh stayed as it
-    /// is, each with its footprint (`batch`); only reads the mesh.
+    /// is (and the smoothing caps as `smoothings` says), each with its footprint (`batch`), in
+    /// batch `epoch`; only reads the mesh.
     fn plan_ahead(&self, t: u32, tv: [u32; 4], smoothings: &[u8], epoch: u32) -> batch::Ahead {
         let mut ahead = batch::Ahead {
             epoch,
@@ -455,10 +448,10 @@ impl Improver<'_> {
         ahead
     }
 
-    /// `ahead`'s value if no change of this batch touched its footprint, else `plan()` made
-    /// now: the same value either way. The radius-edge tally of the one used is counted.
-    /// (The unit tests make every plan used again and compare: a footprint that misses what
-    /// a plan read fails them.)
+    /// The plan made `ahead` (in batch `epoch`) if no change since marked a vertex of its
+    /// footprint, else `plan()` made now: the same value either way. The radius-edge tally of
+    /// the one used is counted. (The unit tests make every plan used again and compare: a
+    /// footprint that misses something a plan read fails them.)
     fn use_plan<T: PartialEq + std::fmt::Debug>(
         &mut self,
         ahead: Option<batch::Memo<T>>,
@@ -471,7 +464,6 @@ impl Improver<'_> {
                     .iter()
                     .all(|&v| self.w.unchanged_since(v, epoch)) =>
             {
-                self.counts.used += 1;
                 if cfg!(test) {
                     let again = batch::tallied(|| plan(self));
                     assert_eq!(again.0, m.value, "a plan made ahead went stale");
@@ -479,14 +471,7 @@ impl Improver<'_> {
                 }
                 (m.value, m.tally)
             }
-            ahead => {
-                if ahead.is_some() {
-                    self.counts.replanned += 1;
-                } else {
-                    self.counts.unplanned += 1;
-                }
-                batch::tallied(|| plan(self))
-            }
+            _ => batch::tallied(|| plan(self)),
         };
         self.stats.rho_vetoes += tally.vetoes;
         self.stats.rho_yields += tally.yields;
