@@ -9,6 +9,7 @@
 //! `orient3d` the new tets tile v's star (the degree argument of `flips`). Of all neighbours,
 //! the one whose worst new tet is best is taken, if that beats the worst tet around v.
 
+use super::batch::note;
 use super::constraints::Constraint;
 use super::flips::MIN_GAIN;
 use super::Improver;
@@ -17,6 +18,7 @@ use super::Improver;
 const MAX_STAR: usize = 64;
 
 /// A planned deletion, applied by [`Improver::apply_deletion`].
+#[derive(Debug, PartialEq)]
 pub(crate) struct Deletion {
     v: u32,
     kill: Vec<u32>,
@@ -39,6 +41,7 @@ impl Improver<'_> {
             if !matches!(self.cons[v as usize], Constraint::Free) || star.len() > MAX_STAR {
                 continue;
             }
+            star.iter().for_each(|&s| note(&w.tets[s as usize]));
             let old = w.worst_q(star);
             let mut link: Vec<u32> = star
                 .iter()

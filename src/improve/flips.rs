@@ -18,6 +18,7 @@ const MAX_RING: usize = 12;
 const MAX_SANDWICH: usize = 8;
 
 /// A planned change, applied by [`Improver::apply`].
+#[derive(Debug, PartialEq)]
 pub(crate) struct Plan {
     /// Worst objective of the new tets (+inf when none is created).
     pub new_min: f64,

@@ -24,6 +24,7 @@ const MAX_GROWTH: usize = 8;
 const MAX_CAVITY: usize = 24;
 
 /// A planned insertion, applied by [`Improver::apply_insertion`].
+#[derive(Debug, PartialEq)]
 pub(crate) struct Insertion {
     at: DVec3,
     kill: Vec<u32>,

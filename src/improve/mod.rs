@@ -20,7 +20,20 @@
 //! strictly raises the worst objective of the tets it replaces or moves. Passes repeat until one changes
 //! nothing or the budget is spent. Order: by objective, then tet slot; no hashing decides
 //! anything, so the result is deterministic.
+//!
+//! Threads (`batch`): the driver stays serial (one tet at a time, in heap order, on the
+//! calling thread), but the plans it asks for, which only read the mesh (the best flip, the
+//! smoothing of a vertex, an insertion, a deletion), are made ahead in batches on the run's
+//! threads, each with its footprint (the vertices whose stars and tets it read). A plan made
+//! ahead is used only if no change since its batch began marked a vertex of its footprint,
+//! and made again otherwise: it is then bit for bit the plan the driver would make now. So the
+//! changes, their order, the stats and the mesh are those of the one-thread run for every
+//! thread count (with one thread nothing is planned ahead); the threads decide only how much
+//! planning is done twice. The working mesh's set-up (the tets' objectives and radius-edge
+//! ratios, the vertex stars) is also spread over the threads, each value depending on its own
+//! tet or vertex only.
 
+mod batch;
 mod constraints;
 mod delete;
 mod flips;
@@ -37,6 +50,7 @@ use crate::run::params::{Params, SurfaceMode};
 use crate::run::report::ImproveStats;
 use constraints::Constraint;
 use glam::DVec3;
+use rustc_hash::FxHashMap;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 use topo::Work;
@@ -79,16 +93,15 @@ pub(crate) struct Improver<'s> {
     /// Approximate mode: the boundary vertices that slide on the input surface, and how.
     slide: Option<&'s dyn SurfaceSlide>,
     stats: ImproveStats,
-    /// Changes refused for the radius-edge bound (`ImproveStats::rho_vetoes`; counted by planners
-    /// that only read the mesh).
-    rho_vetoes: std::cell::Cell<usize>,
-    rho_yields: std::cell::Cell<usize>,
 }
 
 /// How the boundary vertices of an approximated surface may move (approximate mode): within
 /// their tangent plane, then put back on the input surface, as long as the boundary triangles
 /// around them stay close to it.
-pub trait SurfaceSlide {
+///
+/// `Sync`: the improver plans on the run's threads (`batch`), and every answer must depend on
+/// the arguments only.
+pub trait SurfaceSlide: Sync {
     /// Whether boundary vertex `v` may move (not at a corner).
     fn slides(&self, v: u32) -> bool;
     /// For a vertex on a feature curve (at `at`): the curve's direction there (it moves along
@@ -113,6 +126,9 @@ const CLIMB_LIMIT_DEG: f64 = 45.0;
 
 /// Smoothings of one vertex per pass at most (each must gain, but gains can be small).
 const MAX_SMOOTHINGS: u8 = 2;
+
+/// A heap entry: the tet's objective (`key`), slot and vertices.
+type Entry = (u64, u32, [u32; 4]);
 
 /// Total order key of an objective value (worst first out of a max-heap of `Reverse`).
 fn key(q: f64) -> u64 {
@@ -181,8 +197,6 @@ fn improve_work(
         normals,
         slide,
         stats: ImproveStats::default(),
-        rho_vetoes: Default::default(),
-        rho_yields: Default::default(),
     };
     im.stats.degenerate_before = (0..im.w.tets.len())
         .filter(|&t| im.w.q[t] < SURELY_POSITIVE && !im.w.positive(im.w.tets[t]))
@@ -190,24 +204,22 @@ fn improve_work(
     if opts.improve || im.stats.degenerate_before > 0 {
         im.run(opts);
     }
-    im.stats.rho_vetoes = im.rho_vetoes.get();
-    im.stats.rho_yields = im.rho_yields.get();
     im.stats.seconds = start.elapsed().as_secs_f64();
     (im.w.into_mesh(), im.stats)
 }
 
 impl Improver<'_> {
-    /// `Work::keeps_rho` as a yes or no, counting the refusals and where the bound gave way.
+    /// `Work::keeps_rho` as a yes or no, counting the refusals and where the bound gave way
+    /// (for the plan running on this thread: `batch::tallied`).
     fn keeps_rho(&self, old: &[u32], new: impl IntoIterator<Item = [DVec3; 4]>) -> bool {
-        let count = |c: &std::cell::Cell<usize>| c.set(c.get() + 1);
         match self.w.keeps_rho(old, new) {
             topo::RhoCheck::Keeps => true,
             topo::RhoCheck::GivesWay => {
-                count(&self.rho_yields);
+                batch::count_rho(false);
                 true
             }
             topo::RhoCheck::Vetoed => {
-                count(&self.rho_vetoes);
+                batch::count_rho(true);
                 false
             }
         }
@@ -281,11 +293,28 @@ impl Improver<'_> {
             .fold(f64::INFINITY, f64::min)
     }
 
+    /// Whether the heap entry (`t`, `tv`) is to be worked on now: the tet is still there and
+    /// bad, and something changed around it since it was last tried in vain.
+    fn due(&self, t: u32, tv: [u32; 4], target: f64, improve: bool, st: &PassState) -> bool {
+        let ti = t as usize;
+        if !self.w.alive[ti] || self.w.tets[ti] != tv || !self.bad(t, target, improve) {
+            return false;
+        }
+        let tried = st.tried.get(ti).copied().unwrap_or(0);
+        tried == 0 || tv.iter().any(|&v| st.stamp[v as usize] > tried)
+    }
+
     /// One pass over the tets below `target` (or only the flat and inverted ones when not
     /// `improve`), worst first; returns the number of changes.
+    ///
+    /// With several threads, the plans are made ahead in batches (`batch`): when the tet taken
+    /// from the heap has none, the next due tets of the heap get theirs on the run's threads,
+    /// against the mesh as it stands. The tets are still taken and worked on one at a time in
+    /// heap order, and a plan made ahead is used only where it is the one `work_on` would make
+    /// now, so the changes are those of the serial loop.
     fn pass(&mut self, target: f64, improve: bool, st: &mut PassState) -> usize {
         self.stats.passes += 1;
-        let mut heap: BinaryHeap<Reverse<(u64, u32, [u32; 4])>> = BinaryHeap::new();
+        let mut heap: BinaryHeap<Reverse<Entry>> = BinaryHeap::new();
         for t in 0..self.w.tets.len() as u32 {
             if self.w.alive[t as usize] && self.bad(t, target, improve) {
                 heap.push(Reverse((
@@ -295,26 +324,37 @@ impl Improver<'_> {
                 )));
             }
         }
+        let ahead = crate::parallel::current_threads() > 1;
+        let mut planned: FxHashMap<(u32, [u32; 4]), batch::Ahead> = FxHashMap::default();
+        // The last entry the latest batch looked at: a later entry without plans starts the
+        // next batch, an earlier one (made since) is planned when worked on.
+        let mut horizon: Option<Entry> = None;
         let mut changes = 0;
         let mut smoothings = vec![0u8; self.w.pos.len()];
-        while let Some(Reverse((_, t, tv))) = heap.pop() {
+        while let Some(Reverse(entry)) = heap.pop() {
             if changes >= st.budget {
                 break;
             }
-            let ti = t as usize;
-            if !self.w.alive[ti] || self.w.tets[ti] != tv || !self.bad(t, target, improve) {
+            let (_, t, tv) = entry;
+            let mut plans = planned.remove(&(t, tv));
+            if !self.due(t, tv, target, improve, st) {
                 continue;
             }
-            if st.tried[ti] != 0 && tv.iter().all(|&v| st.stamp[v as usize] <= st.tried[ti]) {
-                continue;
+            if ahead && plans.is_none() && horizon.is_none_or(|h| entry > h) {
+                heap.push(Reverse(entry));
+                horizon =
+                    self.plan_batch(&mut heap, &mut planned, &smoothings, target, improve, st);
+                heap.pop();
+                plans = planned.remove(&(t, tv));
             }
-            let (touched, capped) = self.work_on(t, tv, &mut smoothings, st);
+            let (touched, capped) =
+                self.work_on(t, tv, &mut smoothings, st, plans.unwrap_or_default());
             if st.tried.len() < self.w.tets.len() {
                 st.tried.resize(self.w.tets.len(), 0);
             }
             if touched.is_empty() {
                 if !capped {
-                    st.tried[ti] = st.clock;
+                    st.tried[t as usize] = st.clock;
                 }
                 continue;
             }
@@ -332,22 +372,127 @@ impl Improver<'_> {
         }
         changes
     }
+
+    /// Makes the plans of the next `batch::batch_size` due entries of `heap` that have none,
+    /// on the run's threads, into `planned`; the heap is left as it was. Returns the last
+    /// entry looked at.
+    fn plan_batch(
+        &mut self,
+        heap: &mut BinaryHeap<Reverse<Entry>>,
+        planned: &mut FxHashMap<(u32, [u32; 4]), batch::Ahead>,
+        smoothings: &[u8],
+        target: f64,
+        improve: bool,
+        st: &PassState,
+    ) -> Option<Entry> {
+        let t0 = std::time::Instant::now();
+        let size = batch::batch_size(crate::parallel::current_threads());
+        let mut seen: Vec<Entry> = Vec::with_capacity(4 * size);
+        let mut batch: Vec<(u32, [u32; 4])> = Vec::with_capacity(size);
+        while batch.len() < size && seen.len() < 4 * size {
+            let Some(Reverse(e)) = heap.pop() else {
+                break;
+            };
+            seen.push(e);
+            let (_, t, tv) = e;
+            if !planned.contains_key(&(t, tv)) && self.due(t, tv, target, improve, st) {
+                batch.push((t, tv));
+            }
+        }
+        let horizon = seen.last().copied();
+        heap.extend(seen.into_iter().map(Reverse));
+        // (A tet in the heap twice is planned once.)
+        batch.sort_unstable();
+        batch.dedup();
+        self.w.epoch += 1;
+        let epoch = self.w.epoch;
+        let this = &*self;
+        let plans =
+            batch::map_in_order(&batch, |&(t, tv)| this.plan_ahead(t, tv, smoothings, epoch));
+        planned.extend(batch.into_iter().zip(plans));
+        self.stats.seconds_plans += t0.elapsed().as_secs_f64();
+        horizon
+    }
 }
 
 impl Improver<'_> {
+    /// The plans `work_on` would ask for on tet `t` (vertices `tv`) if the mesh stayed as it
+    /// is (and the smoothing caps as `smoothings` says), each with its footprint (`batch`), in
+    /// batch `epoch`; only reads the mesh.
+    fn plan_ahead(&self, t: u32, tv: [u32; 4], smoothings: &[u8], epoch: u32) -> batch::Ahead {
+        let mut ahead = batch::Ahead {
+            epoch,
+            flip: Some(batch::recorded(&tv, || self.best_plan(t))),
+            ..Default::default()
+        };
+        if ahead.flip.as_ref().is_some_and(|m| m.value.is_some()) {
+            return ahead;
+        }
+        let mut capped = false;
+        for (k, v) in tv.into_iter().enumerate() {
+            if smoothings[v as usize] >= MAX_SMOOTHINGS {
+                capped = true;
+                continue;
+            }
+            let m = batch::recorded(&[], || self.plan_smoothing(v));
+            let moves = matches!(m.value, smooth::Smoothing::Move(_));
+            ahead.smooth[k] = Some(m);
+            if moves {
+                return ahead;
+            }
+        }
+        if !capped {
+            ahead.insertion = Some(batch::recorded(&tv, || self.plan_insertion(t)));
+            ahead.deletion = Some(batch::recorded(&tv, || self.plan_deletion(t)));
+        }
+        ahead
+    }
+
+    /// The plan made `ahead` (in batch `epoch`) if no change since marked a vertex of its
+    /// footprint, else `plan()` made now: the same value either way. The radius-edge tally of
+    /// the one used is counted. (The unit tests make every plan used again and compare: a
+    /// footprint that misses something a plan read fails them.)
+    fn use_plan<T: PartialEq + std::fmt::Debug>(
+        &mut self,
+        ahead: Option<batch::Memo<T>>,
+        epoch: u32,
+        plan: impl Fn(&Self) -> T,
+    ) -> T {
+        let (value, tally) = match ahead {
+            Some(m)
+                if m.footprint
+                    .iter()
+                    .all(|&v| self.w.unchanged_since(v, epoch)) =>
+            {
+                if cfg!(test) {
+                    let again = batch::tallied(|| plan(self));
+                    assert_eq!(again.0, m.value, "a plan made ahead went stale");
+                    assert_eq!(again.1, m.tally, "a plan made ahead went stale");
+                }
+                (m.value, m.tally)
+            }
+            _ => batch::tallied(|| plan(self)),
+        };
+        self.stats.rho_vetoes += tally.vetoes;
+        self.stats.rho_yields += tally.yields;
+        value
+    }
+
     /// Tries the best flip touching tet `t` (vertices `tv`), else smoothing of its vertices,
     /// else an insertion around it or the deletion of one of its vertices, whichever is
-    /// better. Returns the tets made or moved (empty: nothing changed them) and whether a
-    /// vertex was skipped for its per-pass smoothing cap.
+    /// better, using the plans made `ahead` that are still valid. Returns the tets made or
+    /// moved (empty: nothing changed them) and whether a vertex was skipped for its per-pass
+    /// smoothing cap.
     fn work_on(
         &mut self,
         t: u32,
         tv: [u32; 4],
         smoothings: &mut Vec<u8>,
         st: &mut PassState,
+        mut ahead: batch::Ahead,
     ) -> (Vec<u32>, bool) {
         let t0 = std::time::Instant::now();
-        let plan = self.best_plan(t);
+        let plan = self.use_plan(ahead.flip.take(), ahead.epoch, |im| im.best_plan(t));
         self.stats.seconds_plans += t0.elapsed().as_secs_f64();
         if let Some(plan) = plan {
             // (A flat tet flipped off its facet makes no tet: `t` is gone all the same.)
@@ -359,7 +504,7 @@ impl Improver<'_> {
             return (touched, false);
         }
         let mut capped = false;
-        for v in tv {
+        for (k, v) in tv.into_iter().enumerate() {
             if smoothings[v as usize] >= MAX_SMOOTHINGS {
                 capped = true;
                 continue;
@@ -367,7 +512,10 @@ impl Improver<'_> {
             smoothings[v as usize] += 1;
             self.stats.smooth_attempts += 1;
             let t0 = std::time::Instant::now();
-            let ok = self.smooth(v);
+            let s = self.use_plan(ahead.smooth[k].take(), ahead.epoch, |im| {
+                im.plan_smoothing(v)
+            });
+            let ok = self.apply_smoothing(v, s);
             self.stats.seconds_smooth += t0.elapsed().as_secs_f64();
             if ok {
                 let touched = self.w.star[v as usize].clone();
@@ -378,8 +526,10 @@ impl Improver<'_> {
         if capped {
             return (vec![], true);
         }
-        let insertion = self.plan_insertion(t);
-        let deletion = self.plan_deletion(t);
+        let insertion = self.use_plan(ahead.insertion.take(), ahead.epoch, |im| {
+            im.plan_insertion(t)
+        });
+        let deletion = self.use_plan(ahead.deletion.take(), ahead.epoch, |im| im.plan_deletion(t));
         let touched = match (insertion, deletion) {
             (Some(i), Some(d)) if d.new_min > i.new_min => self.apply_deletion(d),
             (Some(i), _) => self.apply_insertion(i),

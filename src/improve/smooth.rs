@@ -8,11 +8,13 @@
 //! plane to rounding. A move is kept only if every tet of the star stays positively oriented
 //! by the exact `orient3d` and every boundary triangle around the vertex keeps its side.
 
+use super::batch::note;
 use super::constraints::{on_hull, Constraint};
 use super::flips::MIN_GAIN;
 use super::quality::Objective;
 use super::topo::DEAD;
 use super::Improver;
+use crate::geom::orient3d;
 use glam::DVec3;
 
 /// Gradient steps per smoothing of one vertex.
@@ -21,6 +23,17 @@ const MAX_STEPS: usize = 8;
 const SMOOTH_GAIN: f64 = 1e-5;
 /// Tets within this of the worst are taken as active.
 const ACTIVE: f64 = 1e-3;
+
+/// What smoothing a vertex would do ([`Improver::plan_smoothing`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Smoothing {
+    /// Nothing: no move gains enough, or none is valid.
+    Stays,
+    /// The vertex turns out to be on the hull: it is fixed from now on, unmoved.
+    Fix,
+    /// It moves here.
+    Move(DVec3),
+}
 
 /// The objective of star tet `t` (vertex ids) with vertex `v` at `x`.
 #[inline]
@@ -170,48 +183,68 @@ impl Improver<'_> {
         (x, qx)
     }
 
-    /// Moves vertex v to raise the worst objective of its star; true when it moved.
-    pub(crate) fn smooth(&mut self, v: u32) -> bool {
+    /// Where smoothing would move vertex v to raise the worst objective of its star (only
+    /// reads the mesh: [`Improver::apply_smoothing`] carries it out).
+    pub(crate) fn plan_smoothing(&self, v: u32) -> Smoothing {
         let cons = self.cons[v as usize];
         if cons == Constraint::Fixed {
-            return false;
+            return Smoothing::Stays;
         }
-        let ids = self.w.star[v as usize].clone();
+        note(&[v]);
+        let ids = &self.w.star[v as usize];
         if ids.is_empty() {
-            return false;
-        }
-        if cons == Constraint::Free && on_hull(&self.w, v, &mut Vec::new()) {
-            // A hull face missing from the boundary list: the vertex is on the boundary.
-            self.cons[v as usize] = Constraint::Fixed;
-            return false;
+            return Smoothing::Stays;
         }
         let star: Vec<[u32; 4]> = ids.iter().map(|&t| self.w.tets[t as usize]).collect();
+        star.iter().for_each(|t| note(t));
+        if cons == Constraint::Free && on_hull(&self.w, v, &mut Vec::new()) {
+            // A hull face missing from the boundary list: the vertex is on the boundary.
+            return Smoothing::Fix;
+        }
         let x0 = self.w.p(v);
-        let q0 = self.w.worst_q(&ids);
+        let q0 = self.w.worst_q(ids);
         let (mut x, mut qx) = self.ascend(&star, v, x0, q0, cons);
         if let Some(s) = self.sliding(v) {
             // Back onto the input surface, where the move is judged.
             let Some(y) = s.project(v, x) else {
-                return false;
+                return Smoothing::Stays;
             };
             x = y;
             qx = self.star_min(&star, v, x);
         }
         if qx <= q0 + SMOOTH_GAIN || qx.is_nan() || !self.valid_move(&star, v, x) {
-            return false;
+            return Smoothing::Stays;
         }
         let moved = star
             .iter()
             .map(|tv| tv.map(|u| if u == v { x } else { self.w.p(u) }));
-        if !self.keeps_rho(&ids, moved) {
-            return false;
+        if !self.keeps_rho(ids, moved) {
+            return Smoothing::Stays;
         }
-        self.w.pos[v as usize] = x;
-        for (&t, tv) in ids.iter().zip(&star) {
-            self.w.q[t as usize] = q_at(&self.w.pos, self.w.objective, tv, v, x);
+        Smoothing::Move(x)
+    }
+
+    /// Carries a smoothing out; true when the vertex moved.
+    pub(crate) fn apply_smoothing(&mut self, v: u32, s: Smoothing) -> bool {
+        match s {
+            Smoothing::Stays => false,
+            Smoothing::Fix => {
+                self.cons[v as usize] = Constraint::Fixed;
+                self.w.touch(v);
+                false
+            }
+            Smoothing::Move(x) => {
+                self.w.pos[v as usize] = x;
+                self.w.touch(v);
+                let objective = self.w.objective;
+                for &t in &self.w.star[v as usize] {
+                    let tv = self.w.tets[t as usize];
+                    self.w.q[t as usize] = q_at(&self.w.pos, objective, &tv, v, x);
+                }
+                self.stats.smoothed += 1;
+                true
+            }
         }
-        self.stats.smoothed += 1;
-        true
     }
 
     /// The slide of boundary vertex `v`, if it slides on the input surface.
@@ -221,8 +254,12 @@ impl Improver<'_> {
     }
 
     /// Exact orientation of every star tet with v at x, and the boundary triangles' sides.
-    fn valid_move(&mut self, star: &[[u32; 4]], v: u32, x: DVec3) -> bool {
+    fn valid_move(&self, star: &[[u32; 4]], v: u32, x: DVec3) -> bool {
         let old = self.w.pos[v as usize];
+        let positive = |t: &[u32; 4]| {
+            let p = t.map(|u| if u == v { x } else { self.w.pos[u as usize] });
+            orient3d(p[0], p[1], p[2], p[3]) > 0.0
+        };
         if let Some(s) = self.sliding(v) {
             // On a curved surface: no boundary triangle turns over, and each stays close.
             for &bt in &self.w.bstar[v as usize] {
@@ -233,12 +270,8 @@ impl Improver<'_> {
                     return false;
                 }
             }
-            self.w.pos[v as usize] = x;
-            let ok = star.iter().all(|&t| self.w.positive(t));
-            self.w.pos[v as usize] = old;
-            return ok;
+            return star.iter().all(positive);
         }
-        let mut side_ok = true;
         for &bt in &self.w.bstar[v as usize] {
             let patch = self.w.bpatch[bt as usize];
             if patch == DEAD {
@@ -252,17 +285,10 @@ impl Improver<'_> {
             };
             let (s0, s1) = (side(old), side(x));
             if s0 == 0.0 || s0.signum() != s1.signum() || s1 == 0.0 {
-                side_ok = false;
-                break;
+                return false;
             }
         }
-        if !side_ok {
-            return false;
-        }
-        self.w.pos[v as usize] = x;
-        let ok = star.iter().all(|&t| self.w.positive(t));
-        self.w.pos[v as usize] = old;
-        ok
+        star.iter().all(positive)
     }
 }
 

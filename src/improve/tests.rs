@@ -117,8 +117,6 @@ fn improver_for(mesh: &TetMesh) -> Improver<'static> {
         normals: vec![],
         slide: None,
         stats: ImproveStats::default(),
-        rho_vetoes: Default::default(),
-        rho_yields: Default::default(),
     }
 }
 
@@ -404,8 +402,6 @@ fn insertion_lifts_a_flat_tet_off_a_fold() {
         normals,
         slide: None,
         stats: ImproveStats::default(),
-        rho_vetoes: Default::default(),
-        rho_yields: Default::default(),
     };
     let plan = im.plan_insertion(0).expect("an insertion");
     let made = im.apply_insertion(plan);
@@ -454,8 +450,6 @@ fn deletion_removes_a_vertex_squeezed_against_a_face() {
         normals,
         slide: None,
         stats: ImproveStats::default(),
-        rho_vetoes: Default::default(),
-        rho_yields: Default::default(),
     };
     let worst = (0..4u32)
         .min_by(|&a, &b| im.w.q[a as usize].total_cmp(&im.w.q[b as usize]))
@@ -470,4 +464,162 @@ fn deletion_removes_a_vertex_squeezed_against_a_face() {
     assert!((vol(&out) - vol(&mesh)).abs() <= 1e-12 * vol(&mesh));
     assert_eq!(out.tet_regions, vec![7]);
     check_no_degenerate(&out).unwrap();
+}
+
+/// A grid of `n`^3 unit cells cut into Kuhn tets (smallest dihedral angle 45 degrees), the
+/// vertices inside the grid jittered (those on a side within it, as `slides`), with its hull
+/// triangles as the boundary when `boundary`.
+fn jittered_grid(n: usize, boundary: bool) -> TetMesh {
+    let m = n + 1;
+    let id = |i: usize, j: usize, k: usize| (i * m * m + j * m + k) as u32;
+    let mut vertices = vec![];
+    for i in 0..m {
+        for j in 0..m {
+            for k in 0..m {
+                let jitter = |salt: usize| {
+                    let h = (i * 73_856_093) ^ (j * 19_349_663) ^ (k * 83_492_791) ^ (salt * 97);
+                    (h % 1001) as f64 / 1000.0 - 0.5
+                };
+                let inside = |c: usize| c > 0 && c < n;
+                let mut p = DVec3::new(i as f64, j as f64, k as f64);
+                for (axis, c) in [i, j, k].into_iter().enumerate() {
+                    if inside(c) {
+                        p[axis] += 0.2 * jitter(axis + 1);
+                    }
+                }
+                vertices.push(p);
+            }
+        }
+    }
+    let mut tets = vec![];
+    for i in 0..n {
+        for j in 0..n {
+            for k in 0..n {
+                let c = [
+                    id(i, j, k),
+                    id(i + 1, j, k),
+                    id(i + 1, j + 1, k),
+                    id(i, j + 1, k),
+                    id(i, j, k + 1),
+                    id(i + 1, j, k + 1),
+                    id(i + 1, j + 1, k + 1),
+                    id(i, j + 1, k + 1),
+                ];
+                for t in [
+                    [0, 1, 2, 6],
+                    [0, 2, 3, 6],
+                    [0, 3, 7, 6],
+                    [0, 7, 4, 6],
+                    [0, 4, 5, 6],
+                    [0, 5, 1, 6],
+                ] {
+                    tets.push(positively_oriented(t.map(|x| c[x]), &vertices));
+                }
+            }
+        }
+    }
+    let mut hull = vec![];
+    if boundary {
+        let mut faces: Vec<([u32; 3], [u32; 3])> = tets
+            .iter()
+            .flat_map(|&t| (0..4).map(move |i| topo::face(t, i)))
+            .map(|f| (topo::key3(f), f))
+            .collect();
+        faces.sort_unstable();
+        for (k, g) in faces.chunk_by(|a, b| a.0 == b.0).enumerate() {
+            if g.len() == 1 {
+                hull.push((k, g[0].1));
+            }
+        }
+    }
+    TetMesh {
+        vertices,
+        tet_regions: vec![0; tets.len()],
+        tets,
+        boundary_markers: vec![1; hull.len()],
+        boundary: hull.into_iter().map(|(_, f)| f).collect(),
+    }
+}
+
+/// Vertices on one side of the grid of `n` cells (not on its edges) slide in that side.
+struct GridSides {
+    n: usize,
+    vertices: Vec<DVec3>,
+}
+
+impl GridSides {
+    /// The axis of the side vertex `v` is on, if exactly one.
+    fn side(&self, v: u32) -> Option<usize> {
+        let p = self.vertices.get(v as usize)?;
+        let on = |c: f64| c == 0.0 || c == self.n as f64;
+        let axes: Vec<usize> = (0..3).filter(|&a| on(p[a])).collect();
+        (axes.len() == 1).then_some(axes[0])
+    }
+}
+
+impl SurfaceSlide for GridSides {
+    fn slides(&self, v: u32) -> bool {
+        self.side(v).is_some()
+    }
+
+    fn along(&self, _: u32, _: DVec3) -> Option<DVec3> {
+        None
+    }
+
+    fn project(&self, v: u32, mut x: DVec3) -> Option<DVec3> {
+        let a = self.side(v)?;
+        x[a] = self.vertices[v as usize][a];
+        Some(x)
+    }
+
+    fn keeps_close(&self, _: [DVec3; 3]) -> bool {
+        true
+    }
+}
+
+/// On several threads the plans are made ahead in batches; in this build every plan used as
+/// made ahead is made again and compared (`Improver::use_plan`), so a footprint that misses
+/// something a plan read fails here. The meshes and stats match the one-thread run's. Every
+/// tet of the grids is below the 60-degree target: many batches, flips, smoothings (hull
+/// vertices found and fixed, sides sliding), insertions, deletions and radius-edge vetoes.
+#[test]
+fn plans_made_ahead_are_the_plans_made_now() {
+    let untimed = |s: &ImproveStats| ImproveStats {
+        seconds: 0.0,
+        seconds_plans: 0.0,
+        seconds_smooth: 0.0,
+        ..s.clone()
+    };
+    let opts = Options {
+        target_deg: 60.0,
+        ..Options::default()
+    };
+    let kept = Options {
+        keep_rho: 1.2,
+        ..opts
+    };
+    for (boundary, opts) in [(false, opts), (true, opts), (true, kept)] {
+        let mesh = jittered_grid(8, boundary);
+        assert!(mesh.tets.iter().all(|t| {
+            let p = t.map(|v| mesh.vertices[v as usize]);
+            orient3d(p[0], p[1], p[2], p[3]) > 0.0
+        }));
+        let sides = GridSides {
+            n: 8,
+            vertices: mesh.vertices.clone(),
+        };
+        let slide: Option<&dyn SurfaceSlide> = if boundary { Some(&sides) } else { None };
+        let run = |threads| {
+            crate::parallel::with_threads(threads, || improve_with(&mesh, None, &opts, slide))
+        };
+        let (want, stats) = run(1);
+        assert!(stats.smoothed > 0 && stats.edge_removals > 0, "{stats:?}");
+        for threads in [2, 3] {
+            let (got, s) = run(threads);
+            assert!(got == want, "the mesh differs with {threads} threads");
+            assert_eq!(untimed(&s), untimed(&stats), "{threads} threads");
+        }
+        check_no_degenerate(&want).unwrap();
+        assert!((vol(&want) - vol(&mesh)).abs() <= 1e-9 * vol(&mesh));
+    }
 }

@@ -1,6 +1,7 @@
 //! The improver's working mesh: tets in slots (a free list keeps ids stable and reuse
 //! deterministic), vertex stars, boundary triangles by sorted key, and the rings around edges.
 
+use super::batch::note;
 use super::quality::Objective;
 use crate::geom::orient3d;
 use crate::mesh::TetMesh;
@@ -47,6 +48,11 @@ pub(crate) struct Work {
     /// where refinement did not meet the bound (next to small input angles), changes touching
     /// them are not held to it.
     pub rho_exempt: Vec<bool>,
+    /// Per vertex: the batch (`epoch`) in which a change last marked it (`touch`), so that a
+    /// plan made at the start of the batch is known to be still the plan (`batch`).
+    changed_at: Vec<u32>,
+    /// The current batch.
+    pub epoch: u32,
 }
 
 /// What the radius-edge bound says of a change (`Work::keeps_rho`).
@@ -94,6 +100,36 @@ pub(crate) fn even_perm(t: &[u32; 4], p: [u32; 4]) -> bool {
     inv % 2 == 0
 }
 
+/// Puts every tet id into the stars of its vertices, in id order (as `Work::push_tet` would
+/// one tet after the other). On the run's threads: each takes a range of vertices and scans
+/// all the tets for them, so every star gets the same ids in the same order whatever the
+/// thread count. The stars already hold the room they need (nothing is allocated here: a
+/// star allocated on a pool thread would live in that thread's heap).
+fn fill_stars(star: &mut [Vec<u32>], tets: &[[u32; 4]]) {
+    let fill = |lo: usize, stars: &mut [Vec<u32>]| {
+        let hi = lo + stars.len();
+        for (i, t) in tets.iter().enumerate() {
+            for &v in t {
+                let v = v as usize;
+                if (lo..hi).contains(&v) {
+                    stars[v - lo].push(i as u32);
+                }
+            }
+        }
+    };
+    let threads = crate::parallel::current_threads();
+    if threads <= 1 || tets.len() < 1 << 16 {
+        return fill(0, star);
+    }
+    let chunk = star.len().div_ceil(threads);
+    crate::parallel::install(|| {
+        use rayon::prelude::*;
+        star.par_chunks_mut(chunk)
+            .enumerate()
+            .for_each(|(k, s)| fill(k * chunk, s));
+    });
+}
+
 impl Work {
     pub fn new(mesh: &TetMesh, objective: Objective) -> Work {
         let n = mesh.vertices.len();
@@ -115,6 +151,8 @@ impl Work {
             deleted: vec![],
             rho_limit: f64::INFINITY,
             rho_exempt: vec![],
+            changed_at: vec![0; n],
+            epoch: 0,
         };
         let mut degree = vec![0u32; n];
         mesh.tets
@@ -126,13 +164,15 @@ impl Work {
         }
         // The tets' objectives on the run's threads (`crate::parallel`, in tet order).
         let pos = &w.pos;
-        let qs = crate::parallel::map_collect(&mesh.tets, |t| {
+        w.q = crate::parallel::map_collect(&mesh.tets, |t| {
             let [a, b, c, d] = t.map(|v| pos[v as usize]);
             objective.of(a, b, c, d)
         });
-        for (i, (&t, q)) in mesh.tets.iter().zip(qs).enumerate() {
-            w.push_tet(t, mesh.tet_regions.get(i).copied().unwrap_or(0), q);
-        }
+        w.tets.extend_from_slice(&mesh.tets);
+        w.region
+            .extend((0..mesh.tets.len()).map(|i| mesh.tet_regions.get(i).copied().unwrap_or(0)));
+        w.alive.resize(mesh.tets.len(), true);
+        fill_stars(&mut w.star, &mesh.tets);
         w.bmap.reserve(mesh.boundary.len());
         for (i, &f) in mesh.boundary.iter().enumerate() {
             w.bmap.insert(key3(f), i as u32);
@@ -141,6 +181,19 @@ impl Work {
             }
         }
         w
+    }
+
+    /// Marks vertex `v` as changed in this batch (its star, position, constraint or boundary
+    /// triangles, or the objective of a tet around it).
+    #[inline]
+    pub fn touch(&mut self, v: u32) {
+        self.changed_at[v as usize] = self.epoch;
+    }
+
+    /// Whether no change has marked `v` since batch `epoch` began.
+    #[inline]
+    pub fn unchanged_since(&self, v: u32, epoch: u32) -> bool {
+        self.changed_at[v as usize] < epoch
     }
 
     pub fn p(&self, v: u32) -> DVec3 {
@@ -161,9 +214,11 @@ impl Work {
             return;
         }
         let mut over = vec![false; self.pos.len()];
-        for t in 0..self.tets.len() {
-            let tv = self.tets[t];
-            if self.alive[t] && Self::rho_at(self.points(&tv)) > limit {
+        // The tets' ratios on the run's threads (`crate::parallel`; dead slots are skipped).
+        let rho_over =
+            crate::parallel::map_collect(&self.tets, |t| Self::rho_at(self.points(t)) > limit);
+        for ((tv, &alive), &high) in self.tets.iter().zip(&self.alive).zip(&rho_over) {
+            if alive && high {
                 tv.iter().for_each(|&v| over[v as usize] = true);
             }
         }
@@ -249,6 +304,7 @@ impl Work {
         };
         for v in t {
             self.star[v as usize].push(id);
+            self.touch(v);
         }
         id
     }
@@ -258,6 +314,7 @@ impl Work {
         self.pos.push(x);
         self.star.push(Vec::new());
         self.bstar.push(Vec::new());
+        self.changed_at.push(self.epoch);
         (self.pos.len() - 1) as u32
     }
 
@@ -268,6 +325,7 @@ impl Work {
             if let Some(k) = s.iter().position(|&x| x == id) {
                 s.swap_remove(k);
             }
+            self.touch(v);
         }
         self.alive[id as usize] = false;
         self.free.push(id);
@@ -286,11 +344,13 @@ impl Work {
             if let Some(k) = s.iter().position(|&x| x == i) {
                 s.swap_remove(k);
             }
+            self.touch(v);
         }
         self.btri[i as usize] = f;
         self.bmap.insert(key3(f), i);
         for v in f {
             self.bstar[v as usize].push(i);
+            self.touch(v);
         }
     }
 
@@ -304,6 +364,7 @@ impl Work {
     /// cycle or one path (a broken input).
     pub fn ring(&self, a: u32, b: u32) -> Option<Ring> {
         // (x, y, tet) with (a, b, x, y) positively ordered.
+        note(&[a, b]);
         let mut links: Vec<(u32, u32, u32)> = Vec::with_capacity(12);
         let (sa, sb) = (&self.star[a as usize], &self.star[b as usize]);
         for &t in if sa.len() <= sb.len() { sa } else { sb } {
@@ -311,6 +372,7 @@ impl Work {
             if !(tv.contains(&b) && tv.contains(&a)) {
                 continue;
             }
+            note(tv);
             let mut o = tv.iter().copied().filter(|&v| v != a && v != b);
             let (x, y) = (o.next()?, o.next()?);
             if even_perm(tv, [a, b, x, y]) {
@@ -360,9 +422,11 @@ impl Work {
     pub fn face_tets(&self, f: [u32; 3]) -> ([u32; 2], usize) {
         let mut out = [DEAD; 2];
         let mut n = 0;
+        note(&f);
         for &t in &self.star[f[0] as usize] {
             let tv = &self.tets[t as usize];
             if tv.contains(&f[1]) && tv.contains(&f[2]) {
+                note(tv);
                 if n < 2 {
                     out[n] = t;
                 }
@@ -381,6 +445,7 @@ impl Work {
         self.flat_edges = FxHashSet::default();
         self.q = Vec::new();
         self.rho_exempt = Vec::new();
+        self.changed_at = Vec::new();
         self.free = Vec::new();
         self.to_mesh()
     }
