@@ -82,14 +82,45 @@ const MIN_PARALLEL: usize = 2048;
 /// heap, where the memory the run freed before is: allocated on a pool thread, a big result
 /// took fresh pages and doubled the peak memory of a 582,222-tet run).
 pub fn map_collect<T: Sync, U: Send>(items: &[T], f: impl Fn(&T) -> U + Sync + Send) -> Vec<U> {
-    if items.len() < MIN_PARALLEL || current_threads() <= 1 {
+    map_collect_split(items, Split::LONG_CHEAP_ITEMS, f)
+}
+
+/// How [`map_collect_split`] shares a map between the threads.
+#[derive(Clone, Copy, Debug)]
+pub struct Split {
+    /// Fewer items are mapped on the calling thread.
+    pub min_items: usize,
+    /// Fewest items a thread takes at a time.
+    pub min_chunk: usize,
+    /// Most items a thread takes at a time (small for costly items, so the threads stay busy).
+    pub max_chunk: usize,
+}
+
+impl Split {
+    /// Many cheap items: a thread takes 512 at least.
+    pub const LONG_CHEAP_ITEMS: Split = Split {
+        min_items: MIN_PARALLEL,
+        min_chunk: 512,
+        max_chunk: usize::MAX,
+    };
+}
+
+/// [`map_collect`] with the caller's split between the threads: the same vector for every
+/// thread count and split.
+pub fn map_collect_split<T: Sync, U: Send>(
+    items: &[T],
+    split: Split,
+    f: impl Fn(&T) -> U + Sync + Send,
+) -> Vec<U> {
+    if items.len() < split.min_items || current_threads() <= 1 {
         return items.iter().map(f).collect();
     }
     let mut out = Vec::with_capacity(items.len());
     install(|| {
         items
             .par_iter()
-            .with_min_len(512)
+            .with_min_len(split.min_chunk)
+            .with_max_len(split.max_chunk)
             .map(f)
             .collect_into_vec(&mut out)
     });

@@ -34,7 +34,6 @@
 
 use super::flips::Plan;
 use super::{delete::Deletion, insert::Insertion, smooth::Smoothing};
-use rayon::prelude::*;
 use std::cell::{Cell, RefCell};
 
 /// Entries a batch plans per thread of the run. Any size gives the same mesh; larger batches
@@ -132,20 +131,10 @@ pub(crate) struct Ahead {
     pub deletion: Option<Memo<Option<Deletion>>>,
 }
 
-/// `items.iter().map(f).collect()` on the run's threads (`crate::parallel::install`), in
-/// order. Unlike `crate::parallel::map_collect` it splits short slices: a batch has a few
-/// hundred items, each worth tens of microseconds. Each value depends on its own item only.
-pub(crate) fn map_in_order<T: Sync, U: Send>(
-    items: &[T],
-    f: impl Fn(&T) -> U + Sync + Send,
-) -> Vec<U> {
-    let mut out = Vec::with_capacity(items.len());
-    crate::parallel::install(|| {
-        items
-            .par_iter()
-            .with_max_len(4)
-            .map(f)
-            .collect_into_vec(&mut out)
-    });
-    out
-}
+/// How a batch's plans are shared between the threads: a batch has a few hundred items, each
+/// worth tens of microseconds, so a thread takes a few at a time.
+pub(crate) const PLAN_SPLIT: crate::parallel::Split = crate::parallel::Split {
+    min_items: 2,
+    min_chunk: 1,
+    max_chunk: 4,
+};

@@ -407,8 +407,9 @@ impl Improver<'_> {
         self.w.epoch += 1;
         let epoch = self.w.epoch;
         let this = &*self;
-        let plans =
-            batch::map_in_order(&batch, |&(t, tv)| this.plan_ahead(t, tv, smoothings, epoch));
+        let plans = crate::parallel::map_collect_split(&batch, batch::PLAN_SPLIT, |&(t, tv)| {
+            this.plan_ahead(t, tv, smoothings, epoch)
+        });
         planned.extend(batch.into_iter().zip(plans));
         self.stats.seconds_plans += t0.elapsed().as_secs_f64();
         horizon

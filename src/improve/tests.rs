@@ -20,6 +20,43 @@ fn positively_oriented(mut t: [u32; 4], vertices: &[DVec3]) -> [u32; 4] {
     t
 }
 
+/// The Kuhn split of an `n`^3 grid of cells into 6 positively oriented tets each; `id` numbers
+/// the grid's (n + 1)^3 vertices.
+fn kuhn_tets(
+    n: usize,
+    id: impl Fn(usize, usize, usize) -> u32,
+    vertices: &[DVec3],
+) -> Vec<[u32; 4]> {
+    let mut tets = vec![];
+    for i in 0..n {
+        for j in 0..n {
+            for k in 0..n {
+                let c = [
+                    id(i, j, k),
+                    id(i + 1, j, k),
+                    id(i + 1, j + 1, k),
+                    id(i, j + 1, k),
+                    id(i, j, k + 1),
+                    id(i + 1, j, k + 1),
+                    id(i + 1, j + 1, k + 1),
+                    id(i, j + 1, k + 1),
+                ];
+                for t in [
+                    [0, 1, 2, 6],
+                    [0, 2, 3, 6],
+                    [0, 3, 7, 6],
+                    [0, 7, 4, 6],
+                    [0, 4, 5, 6],
+                    [0, 5, 1, 6],
+                ] {
+                    tets.push(positively_oriented(t.map(|x| c[x]), vertices));
+                }
+            }
+        }
+    }
+    tets
+}
+
 fn min_q(m: &TetMesh) -> f64 {
     m.tets
         .iter()
@@ -204,40 +241,9 @@ fn deterministic() {
         }
     }
     let n = vertices.len();
-    let mut tets = vec![];
     // A Kuhn triangulation of the grid cells (valid for the small jitter used).
     let id = |i: usize, j: usize, k: usize| (i * 16 + j * 4 + k) as u32;
-    for i in 0..3 {
-        for j in 0..3 {
-            for k in 0..3 {
-                let c = [
-                    id(i, j, k),
-                    id(i + 1, j, k),
-                    id(i + 1, j + 1, k),
-                    id(i, j + 1, k),
-                    id(i, j, k + 1),
-                    id(i + 1, j, k + 1),
-                    id(i + 1, j + 1, k + 1),
-                    id(i, j + 1, k + 1),
-                ];
-                for t in [
-                    [0, 1, 2, 6],
-                    [0, 2, 3, 6],
-                    [0, 3, 7, 6],
-                    [0, 7, 4, 6],
-                    [0, 4, 5, 6],
-                    [0, 5, 1, 6],
-                ] {
-                    let mut tv = t.map(|x| c[x]);
-                    let p = tv.map(|v| vertices[v as usize]);
-                    if orient3d(p[0], p[1], p[2], p[3]) < 0.0 {
-                        tv.swap(0, 1);
-                    }
-                    tets.push(tv);
-                }
-            }
-        }
-    }
+    let tets = kuhn_tets(3, id, &vertices);
     let mesh = TetMesh {
         vertices,
         tet_regions: vec![0; tets.len()],
@@ -491,33 +497,7 @@ fn jittered_grid(n: usize, boundary: bool) -> TetMesh {
             }
         }
     }
-    let mut tets = vec![];
-    for i in 0..n {
-        for j in 0..n {
-            for k in 0..n {
-                let c = [
-                    id(i, j, k),
-                    id(i + 1, j, k),
-                    id(i + 1, j + 1, k),
-                    id(i, j + 1, k),
-                    id(i, j, k + 1),
-                    id(i + 1, j, k + 1),
-                    id(i + 1, j + 1, k + 1),
-                    id(i, j + 1, k + 1),
-                ];
-                for t in [
-                    [0, 1, 2, 6],
-                    [0, 2, 3, 6],
-                    [0, 3, 7, 6],
-                    [0, 7, 4, 6],
-                    [0, 4, 5, 6],
-                    [0, 5, 1, 6],
-                ] {
-                    tets.push(positively_oriented(t.map(|x| c[x]), &vertices));
-                }
-            }
-        }
-    }
+    let tets = kuhn_tets(n, id, &vertices);
     let mut hull = vec![];
     if boundary {
         let mut faces: Vec<([u32; 3], [u32; 3])> = tets
