@@ -41,6 +41,8 @@ pub mod parallel;
 #[doc(hidden)]
 pub mod pipeline;
 #[doc(hidden)]
+pub mod partition;
+#[doc(hidden)]
 pub mod plc;
 #[doc(hidden)]
 pub mod quality;
