@@ -74,6 +74,12 @@ pub struct Domain {
     /// Per facet, what splitting its subfacets reads (built when first needed, then kept up
     /// to date by the splits).
     pub(super) split_caches: Vec<Option<FacetSplitCache>>,
+    /// Per facet: frozen, never split nor flipped (a partition's interface, meshed alike on
+    /// both sides: `crate::partition`). No point is inserted whose cavity would remove one of
+    /// its subfacets; being encroached is allowed.
+    pub frozen: Vec<bool>,
+    /// Whether any facet is frozen.
+    pub any_frozen: bool,
 }
 
 /// Input angles below this (between segments at a vertex, or between facets at a segment) are
@@ -167,6 +173,8 @@ impl Domain {
             created_log: vec![],
             boundary_inserted: false,
             split_caches: Vec::new(),
+            frozen: vec![false; input.facets.len()],
+            any_frozen: false,
         })
     }
 
@@ -336,6 +344,87 @@ impl Domain {
 
     pub fn point(&self, v: u32) -> DVec3 {
         self.dt.point(v)
+    }
+
+    /// Freezes `facets` (see [`Domain::frozen`]).
+    pub fn freeze_facets(&mut self, facets: &[u32]) {
+        for &f in facets {
+            self.frozen[f as usize] = true;
+        }
+        self.any_frozen |= !facets.is_empty();
+    }
+
+    /// Whether the subfacet with sorted vertices `key` is one of a frozen facet.
+    pub fn is_frozen_subfacet(&self, key: &[u32; 3]) -> bool {
+        self.any_frozen
+            && self
+                .subfacets
+                .get(key)
+                .is_some_and(|&f| self.frozen[f as usize])
+    }
+
+    /// Whether subsegment `key` lies on a frozen facet's polygon.
+    pub fn is_frozen_subsegment(&self, key: (u32, u32)) -> bool {
+        self.any_frozen
+            && self.subsegs.get(&key).is_some_and(|&s| {
+                (self.segments[s as usize].facets.iter()).any(|&f| self.frozen[f as usize])
+            })
+    }
+
+    /// A frozen subfacet that inserting `cavity`'s point would remove (both its tets in the
+    /// cavity), as (facet, sorted vertices). A frozen subsegment cannot go without one of its
+    /// frozen subfacets.
+    pub fn frozen_removed_by(&self, cavity: &Cavity) -> Option<(u32, [u32; 3])> {
+        if !self.any_frozen {
+            return None;
+        }
+        let (removed, _) = self.dt.cavity(cavity);
+        for &t in removed {
+            let v = self.dt.tet(t);
+            let neighbors = self.dt.neighbors(t);
+            for (i, n) in neighbors.into_iter().enumerate() {
+                if n < t || !removed.contains(&n) {
+                    continue; // each inner face once
+                }
+                let face = tri_key(crate::delaunay::tables::FACE[i].map(|l| v[l]));
+                if face.contains(&crate::delaunay::INFINITE) {
+                    continue;
+                }
+                if let Some(&f) = self.subfacets.get(&face) {
+                    if self.frozen[f as usize] {
+                        return Some((f, face));
+                    }
+                }
+            }
+        }
+        None
+    }
+
+    /// Whether a point may be inserted at `p` without removing a frozen subfacet (probes its
+    /// cavity from `hint`; a duplicate may not).
+    pub fn may_insert_at(&mut self, p: DVec3, hint: Option<u32>) -> bool {
+        if !self.any_frozen {
+            return true;
+        }
+        match self.dt.probe(p, hint) {
+            crate::delaunay::Probe::Cavity(c) => self.frozen_removed_by(&c).is_none(),
+            crate::delaunay::Probe::Duplicate(_) => false,
+        }
+    }
+
+    /// Checks that every frozen subfacet is a face of the triangulation.
+    pub fn check_frozen_present(&self) -> Result<(), MeshError> {
+        if !self.any_frozen {
+            return Ok(());
+        }
+        for (key, &f) in &self.subfacets {
+            if self.frozen[f as usize] && self.dt.find_face(key[0], key[1], key[2]).is_none() {
+                return Err(MeshError::Internal(format!(
+                    "frozen facet {f}: triangle {key:?} is no longer a face of the mesh"
+                )));
+            }
+        }
+        Ok(())
     }
 
     /// Inserts a new vertex into the 3D triangulation, located from `hint`, or with

@@ -45,6 +45,7 @@ pub fn remove_slivers(existing: &TetMesh, params: &Params) -> Result<(TetMesh, R
         None,
         super::SmallAngles::None,
         Unseeded::Hole,
+        &[],
     )
 }
 

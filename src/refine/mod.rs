@@ -61,6 +61,28 @@ pub fn mesh(
         progress,
         SmallAngles::Input,
         Unseeded::Domain,
+        &[],
+    )
+}
+
+/// [`mesh`] with `frozen` facets (indices into `input.facets`) never split nor flipped: no
+/// point goes where its cavity would remove one of their triangles, and bad tets that would
+/// need one are left (`Refusals::frozen_interface`). For a partition's interfaces
+/// (`crate::partition`): each side meshed alone keeps the same triangles there.
+pub fn mesh_frozen(
+    input: &PlcInput,
+    params: &Params,
+    spacing: Option<&dyn Spacing>,
+    frozen: &[u32],
+) -> Result<(TetMesh, Report), MeshError> {
+    mesh_domain(
+        input,
+        params,
+        spacing,
+        None,
+        SmallAngles::Input,
+        Unseeded::Domain,
+        frozen,
     )
 }
 
@@ -84,6 +106,7 @@ fn mesh_domain(
     progress: Option<Progress>,
     small_angles: SmallAngles,
     unseeded: Unseeded,
+    frozen: &[u32],
 ) -> Result<(TetMesh, Report), MeshError> {
     let start = std::time::Instant::now();
     params.check().map_err(MeshError::InvalidInput)?;
@@ -95,6 +118,13 @@ fn mesh_domain(
         MarkerCaps::new(&surface, &params.marker_sizes)?
     };
     let mut dom = domain::Domain::new(input, &plc)?;
+    if let Some(&f) = frozen.iter().find(|&&f| f as usize >= input.facets.len()) {
+        return Err(MeshError::InvalidInput(format!(
+            "frozen facet {f}: the input has {} facets",
+            input.facets.len()
+        )));
+    }
+    dom.freeze_facets(frozen);
     match small_angles {
         SmallAngles::Input => dom.set_input_angles(&plc, params.small_angle_reach),
         SmallAngles::None => {}
@@ -144,6 +174,7 @@ fn mesh_domain(
         refusals,
     } = passes;
     let seconds_refinement = start.elapsed().as_secs_f64() - seconds_recovery;
+    dom.check_frozen_present()?;
     let mesh = dom.to_mesh(&regions);
     // The triangulation is freed before the report measures the mesh: the two together were
     // the run's peak memory.

@@ -76,6 +76,9 @@ pub(crate) enum Refusal {
     /// Its point encroached the boundary each time it was looked at, the boundary was refined
     /// for it as many times as allowed, and it is left (the approximate mode's cell level).
     WaitedForBoundary,
+    /// Its point, or the boundary split it asked for, would remove a subfacet of a frozen
+    /// facet (a partition's interface, see `Domain::frozen`).
+    FrozenInterface,
 }
 
 impl Refusal {
@@ -105,6 +108,7 @@ impl Refusal {
             Refusal::FlatSubfacet => &mut counts.flat_subfacet,
             Refusal::SubfacetCentreOutside => &mut counts.subfacet_centre_outside,
             Refusal::WaitedForBoundary => &mut counts.waited_for_boundary,
+            Refusal::FrozenInterface => &mut counts.frozen_interface,
         };
         *slot += 1;
         counts.total += 1;
@@ -121,7 +125,7 @@ mod tests {
     use super::*;
     use crate::run::report::Refusals;
 
-    const ALL: [Refusal; 14] = [
+    const ALL: [Refusal; 15] = [
         Refusal::Futile,
         Refusal::FlatByConstruction,
         Refusal::NoCircumsphere,
@@ -136,6 +140,7 @@ mod tests {
         Refusal::FlatSubfacet,
         Refusal::SubfacetCentreOutside,
         Refusal::WaitedForBoundary,
+        Refusal::FrozenInterface,
     ];
 
     /// Every reason is counted in a field of its own, named in `counts` as in the JSON report,

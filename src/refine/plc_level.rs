@@ -42,6 +42,9 @@ impl FacetLevel for Domain {
     }
 
     fn judge(&self, b: Boundary, r: f64, request: Request) -> Conflict<Boundary> {
+        if self.is_frozen(b) {
+            return Conflict::Refused(Refusal::FrozenInterface);
+        }
         let large = self.boundary_radius(b) >= CASCADE_RADIUS_FRACTION * r;
         match request {
             // Splitting the boundary next to a small angle for shape would never end (the
@@ -77,6 +80,9 @@ impl Domain {
     /// the smallest subsegment (by key), else the smallest subfacet.
     fn boundary_in_cavity(&self, cavity: &Cavity) -> Option<Boundary> {
         let dom = self;
+        if let Some((f, t)) = dom.frozen_removed_by(cavity) {
+            return Some(Boundary::Facet(f, t)); // refused by the policy
+        }
         let p = cavity.point();
         let (removed, faces) = dom.dt.cavity(cavity);
         // Every vertex of a cavity tet is on the cavity's boundary, and a ring tet adds one
@@ -157,6 +163,14 @@ impl Domain {
         }
     }
 
+    /// Whether `b` lies on a frozen facet (see `Domain::frozen`).
+    fn is_frozen(&self, b: Boundary) -> bool {
+        match b {
+            Boundary::Segment(a, c) => self.is_frozen_subsegment(seg_key(a, c)),
+            Boundary::Facet(f, _) => self.frozen[f as usize],
+        }
+    }
+
     /// Why a split of `b` for a much larger cell is refused: a cascade, next to a small angle
     /// or not.
     fn cascade(&self, b: Boundary) -> Refusal {
@@ -202,10 +216,10 @@ impl Domain {
     /// around the new vertex (the subsegment and subfacet queues, `Domain::settle`).
     fn split_boundary(&mut self, b: Boundary, picker: &mut Picker) -> Result<Outcome, MeshError> {
         let split = match b {
-            Boundary::Segment(a, c) => {
-                self.split_segment_picked(a, c, picker)?;
-                BoundaryKind::Segment
-            }
+            Boundary::Segment(a, c) => match self.split_segment_picked(a, c, picker)? {
+                Ok(()) => BoundaryKind::Segment,
+                Err(refusal) => return Ok(Outcome::Refused(refusal)),
+            },
             Boundary::Facet(f, t) => match self.split_subfacet_picked(f, t, picker)? {
                 Ok(kind) => kind,
                 Err(refusal) => return Ok(Outcome::Refused(refusal)),
@@ -242,8 +256,9 @@ impl Domain {
             .map(|b| b.key)
             .min();
         if let Some((a, c)) = enc {
-            self.split_segment_picked(a, c, picker)?;
-            return Ok(Ok(BoundaryKind::Segment));
+            return Ok(self
+                .split_segment_picked(a, c, picker)?
+                .map(|()| BoundaryKind::Segment));
         }
         if self.facets[f as usize].locate_near(cf, t[0]).is_none() {
             return Ok(Err(Refusal::SubfacetCentreOutside));
@@ -279,6 +294,9 @@ impl Domain {
             None => (cf, None),
         };
         let hint = self.dt.vertex_tet(t[0]);
+        if !self.may_insert_with(p, hint, &cavity) {
+            return Ok(Err(Refusal::FrozenInterface));
+        }
         self.split_in_facet(f, p, hint, cavity)?;
         Ok(Ok(BoundaryKind::Facet))
     }
@@ -310,7 +328,10 @@ impl Domain {
         a: u32,
         c: u32,
         picker: &mut Picker,
-    ) -> Result<(), MeshError> {
+    ) -> Result<Result<(), Refusal>, MeshError> {
+        if self.is_frozen_subsegment(seg_key(a, c)) {
+            return Ok(Err(Refusal::FrozenInterface));
+        }
         let (pa, pc) = (self.point(a), self.point(c));
         let shell = self.acute_vertices.contains(&a) != self.acute_vertices.contains(&c);
         let (p, cavity) = if shell {
@@ -331,8 +352,22 @@ impl Domain {
                 None => (pa + (pc - pa) * 0.5, None),
             }
         };
+        let hint = self.dt.vertex_tet(a);
+        if !self.may_insert_with(p, hint, &cavity) {
+            return Ok(Err(Refusal::FrozenInterface));
+        }
         self.split_subsegment(a, c, p, cavity)?;
-        Ok(())
+        Ok(Ok(()))
+    }
+
+    /// [`Domain::may_insert_at`], with `p`'s probe when there is one (kept current).
+    fn may_insert_with(&mut self, p: DVec3, hint: Option<u32>, probed: &Option<Cavity>) -> bool {
+        match probed {
+            Some(c) if c.point() == p && self.dt.is_current(c) => {
+                self.frozen_removed_by(c).is_none()
+            }
+            _ => self.may_insert_at(p, hint),
+        }
     }
 }
 

@@ -85,14 +85,22 @@ impl Domain {
     pub fn settle(&mut self, budget: &mut usize) -> Result<Settled, MeshError> {
         loop {
             if let Some((a, b)) = self.dirty_segs.pop() {
-                if !self.subsegs.contains_key(&(a, b)) || self.subsegment_status(a, b) == Status::Ok
-                {
+                if !self.subsegs.contains_key(&(a, b)) {
+                    continue;
+                }
+                let status = self.subsegment_status(a, b);
+                if status == Status::Ok {
                     continue;
                 }
                 if !spend(budget) {
                     return Ok(Settled::BudgetSpent);
                 }
                 let p = self.segment_split_point(a, b);
+                let hint = self.dt.vertex_tet(a);
+                if self.is_frozen_subsegment((a, b)) || !self.may_insert_at(p, hint) {
+                    frozen_missing(status, &format!("subsegment ({a}, {b})"))?;
+                    continue;
+                }
                 self.split_subsegment(a, b, p, None)?;
                 continue;
             }
@@ -102,10 +110,15 @@ impl Domain {
             let Some(&f) = self.subfacets.get(&tri) else {
                 continue;
             };
-            let within_budget = match self.subfacet_status(tri) {
+            let status = self.subfacet_status(tri);
+            if status != Status::Ok && self.frozen[f as usize] {
+                frozen_missing(status, &format!("subfacet {tri:?} of facet {f}"))?;
+                continue;
+            }
+            let within_budget = match status {
                 Status::Ok => true,
                 Status::Missing if self.flip_to_match(f, tri) => true,
-                _ => self.split_subfacet(f, tri, budget)?,
+                _ => self.split_subfacet(f, tri, status, budget)?,
             };
             if !within_budget {
                 return Ok(Settled::BudgetSpent);
@@ -153,9 +166,15 @@ impl Domain {
         Status::Ok
     }
 
-    /// Inside a protecting ball an encroached element that is present is left alone.
+    /// Inside a protecting ball an encroached element that is present is left alone, and so
+    /// is one of a frozen facet.
     fn encroached_unless_protected(&self, verts: &[u32]) -> Status {
-        if self.protected(verts) {
+        let frozen = match *verts {
+            [a, b] => self.is_frozen_subsegment(seg_key(a, b)),
+            [a, b, c] => self.is_frozen_subfacet(&tri_key([a, b, c])),
+            _ => false,
+        };
+        if frozen || self.protected(verts) {
             Status::Ok
         } else {
             Status::Encroached
@@ -205,8 +224,10 @@ impl Domain {
         &mut self,
         f: u32,
         tri: [u32; 3],
+        status: Status,
         budget: &mut usize,
     ) -> Result<bool, MeshError> {
+        let what = format!("subfacet {tri:?} of facet {f}");
         let [a, b, c] = tri.map(|v| self.point(v));
         let Some(centre) = tri_circumcenter(a, b, c) else {
             return Err(MeshError::Internal(format!(
@@ -222,6 +243,11 @@ impl Domain {
                         return Ok(false);
                     }
                     let p = self.segment_split_point(x, y);
+                    let hint = self.dt.vertex_tet(x);
+                    if self.is_frozen_subsegment((x, y)) || !self.may_insert_at(p, hint) {
+                        frozen_missing(status, &what)?;
+                        return Ok(true);
+                    }
                     self.split_subsegment(x, y, p, None)?;
                 }
             }
@@ -243,6 +269,11 @@ impl Domain {
                 return Ok(false);
             }
             let p = self.segment_split_point(x, y);
+            let hint = self.dt.vertex_tet(x);
+            if self.is_frozen_subsegment(seg_key(x, y)) || !self.may_insert_at(p, hint) {
+                frozen_missing(status, &what)?;
+                return Ok(true);
+            }
             self.split_subsegment(x, y, p, None)?;
             self.dirty_tris.push(tri); // looked at again, as above
             return Ok(true);
@@ -253,6 +284,10 @@ impl Domain {
             return Ok(false);
         }
         let hint = self.dt.vertex_tet(tri[0]);
+        if !self.may_insert_at(p, hint) {
+            frozen_missing(status, &what)?;
+            return Ok(true);
+        }
         self.split_in_facet(f, p, hint, None)?;
         Ok(true)
     }
@@ -290,6 +325,17 @@ impl Domain {
         }
         p
     }
+}
+
+/// An element that a frozen facet keeps from being split may stay encroached, but not missing:
+/// the boundary would not conform.
+fn frozen_missing(status: Status, what: &str) -> Result<(), MeshError> {
+    if status == Status::Missing {
+        return Err(MeshError::Internal(format!(
+            "{what} is missing from the mesh and cannot be split next to a frozen interface"
+        )));
+    }
+    Ok(())
 }
 
 /// Spends one split of `budget`; false (nothing spent) when it is spent already.

@@ -154,6 +154,8 @@ pub struct Refusals {
     /// The approximate mode's cell level: its point encroached the boundary, which was
     /// refined for it, each of the times allowed.
     pub waited_for_boundary: usize,
+    /// Its point would remove a subfacet of a partition's frozen interface.
+    pub frozen_interface: usize,
     /// Bad tets still queued when a budget (vertices, or boundary splits) stopped refinement.
     pub budget: usize,
 }
@@ -198,6 +200,7 @@ impl Refusals {
             flat_subfacet,
             subfacet_centre_outside,
             waited_for_boundary,
+            frozen_interface,
             budget,
         } = o;
         self.total += total;
@@ -215,11 +218,12 @@ impl Refusals {
         self.flat_subfacet += flat_subfacet;
         self.subfacet_centre_outside += subfacet_centre_outside;
         self.waited_for_boundary += waited_for_boundary;
+        self.frozen_interface += frozen_interface;
         self.budget += budget;
     }
 
     /// The counts by reason (without the total), named as in the JSON report.
-    pub fn counts(&self) -> [(&'static str, usize); 15] {
+    pub fn counts(&self) -> [(&'static str, usize); 16] {
         let Refusals {
             total: _,
             futile,
@@ -236,6 +240,7 @@ impl Refusals {
             flat_subfacet,
             subfacet_centre_outside,
             waited_for_boundary,
+            frozen_interface,
             budget,
         } = *self;
         [
@@ -253,6 +258,7 @@ impl Refusals {
             ("flat_subfacet", flat_subfacet),
             ("subfacet_centre_outside", subfacet_centre_outside),
             ("waited_for_boundary", waited_for_boundary),
+            ("frozen_interface", frozen_interface),
             ("budget", budget),
         ]
     }
