@@ -43,7 +43,9 @@ pub fn plan(
     parts: usize,
 ) -> Result<Plan, MeshError> {
     if parts == 0 {
-        return Err(MeshError::InvalidInput("a partition needs at least one part".into()));
+        return Err(MeshError::InvalidInput(
+            "a partition needs at least one part".into(),
+        ));
     }
     if params.surface_mode != SurfaceMode::Keep {
         return Err(MeshError::InvalidInput(
