@@ -39,9 +39,9 @@ pub mod mesh;
 #[doc(hidden)]
 pub mod parallel;
 #[doc(hidden)]
-pub mod pipeline;
-#[doc(hidden)]
 pub mod partition;
+#[doc(hidden)]
+pub mod pipeline;
 #[doc(hidden)]
 pub mod plc;
 #[doc(hidden)]
