@@ -57,13 +57,13 @@ fn offsets(counts: &[u64]) -> Vec<usize> {
     out
 }
 
+/// Every rank's data concatenated in rank order, and the offsets of each rank's share (one
+/// more than ranks).
+pub type Gathered<T> = (Vec<T>, Vec<usize>);
+
 /// Every rank's `data`, concatenated in rank order on every rank, and the offsets of each
 /// rank's share.
-pub fn all_gather_varcount<C, T>(
-    comm: &C,
-    data: &[T],
-    what: &str,
-) -> Result<(Vec<T>, Vec<usize>), Error>
+pub fn all_gather_varcount<C, T>(comm: &C, data: &[T], what: &str) -> Result<Gathered<T>, Error>
 where
     C: Communicator,
     T: Equivalence + Copy + Default,
@@ -81,11 +81,7 @@ where
 
 /// Every rank's `data` concatenated in rank order on rank 0 (`None` elsewhere), and the
 /// offsets of each rank's share.
-pub fn gather_varcount<C, T>(
-    comm: &C,
-    data: &[T],
-    what: &str,
-) -> Result<Option<(Vec<T>, Vec<usize>)>, Error>
+pub fn gather_varcount<C, T>(comm: &C, data: &[T], what: &str) -> Result<Option<Gathered<T>>, Error>
 where
     C: Communicator,
     T: Equivalence + Copy + Default,

@@ -116,10 +116,9 @@ pub fn number<C: Communicator>(comm: &C, mesh: &TetMesh) -> Result<Numbering, Er
     let first: u64 = owned_counts[..rank].iter().sum();
     let n_vertices: u64 = owned_counts.iter().sum();
     let mut vertex_ids = vec![u64::MAX; nv];
-    let mut next = first;
-    for (id, _) in vertex_ids.iter_mut().zip(&owned).filter(|(_, &o)| o) {
+    let owned_ids = vertex_ids.iter_mut().zip(&owned).filter(|(_, &o)| o);
+    for (next, (id, _)) in (first..).zip(owned_ids) {
         *id = next;
-        next += 1;
     }
 
     // Owners tell the others: each rank publishes the ids of its candidates that it owns, in
