@@ -660,6 +660,39 @@ pub fn parse_vtu(text: &str) -> Result<VtuData, IoError> {
 mod tests {
     use super::*;
 
+    #[test]
+    fn piece_carries_global_ids_and_the_pvtu_names_pieces() {
+        let mesh = tet_mesh();
+        let points: Vec<i64> = (0..mesh.vertices.len() as i64).map(|i| 10 + i).collect();
+        let cells: Vec<i64> = (0..mesh.tets.len() as i64).map(|i| 7 + i).collect();
+        let ids = GlobalIds {
+            points: &points,
+            cells: &cells,
+        };
+        let mut buf = Vec::new();
+        format_elements(&mut buf, &Elements::new(&mesh, None), &[], Some(ids)).unwrap();
+        let d = parse_vtu(std::str::from_utf8(&buf).unwrap()).unwrap();
+        assert_eq!(d.mesh, mesh);
+        let as_f64 = |v: &[i64]| v.iter().map(|&x| x as f64).collect::<Vec<_>>();
+        assert_eq!(
+            d.point_fields,
+            vec![(GLOBAL_NODE_ID.into(), as_f64(&points))]
+        );
+        assert_eq!(d.cell_fields, vec![(GLOBAL_CELL_ID.into(), as_f64(&cells))]);
+        let mut p = Vec::new();
+        let names = ["a_0.vtu".to_string(), "a_1.vtu".to_string()];
+        format_pvtu(&mut p, &names, &["q"]).unwrap();
+        let p = String::from_utf8(p).unwrap();
+        assert!(
+            p.contains("<Piece Source=\"a_0.vtu\"/>\n<Piece Source=\"a_1.vtu\"/>"),
+            "{p}"
+        );
+        assert!(
+            p.contains("GlobalIds=\"GlobalNodeId\"") && p.contains("Name=\"q\""),
+            "{p}"
+        );
+    }
+
     fn tet_mesh() -> TetMesh {
         TetMesh {
             vertices: vec![
