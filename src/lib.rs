@@ -26,6 +26,11 @@ pub mod api;
 pub mod cdt;
 #[doc(hidden)]
 pub mod delaunay;
+// Distributed meshing on MPI (cargo feature `mpi`): every rank meshes one part of
+// `partition`'s plan; global numbering, output and the per-rank report.
+#[cfg(feature = "mpi")]
+#[doc(hidden)]
+pub mod distributed;
 #[doc(hidden)]
 pub mod ffi;
 #[doc(hidden)]

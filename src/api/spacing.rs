@@ -21,6 +21,20 @@ pub enum SpacingChoice {
     Shared(Box<dyn Spacing + Send + Sync>),
 }
 
+impl SpacingChoice {
+    /// Runs `f` with the spacing this choice stands for: `None` when automatic, a constant as
+    /// `ConstantSpacing`, a `Shared` one split across the run's threads (`SplitSpacing`). For
+    /// callers that mesh without a `Mesher` (`crate::distributed`).
+    pub fn with_spacing<R>(&self, f: impl FnOnce(Option<&dyn Spacing>) -> R) -> R {
+        match self {
+            SpacingChoice::Automatic => f(None),
+            SpacingChoice::Constant(h) => f(Some(&crate::run::spacing::ConstantSpacing(*h))),
+            SpacingChoice::Custom(s) => f(Some(s.as_ref())),
+            SpacingChoice::Shared(s) => f(Some(&crate::parallel::SplitSpacing(s.as_ref()))),
+        }
+    }
+}
+
 impl std::fmt::Debug for SpacingChoice {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {

@@ -210,6 +210,26 @@ pub fn run_mesh(
 ) -> Result<(), String> {
     let params = opts.params(input);
     params.check()?;
+    // Under an MPI launcher with more than one rank, the same command runs distributed; MPI is
+    // finalized when `universe` drops, after the serial run of a single rank too.
+    #[cfg(feature = "mpi")]
+    let universe = super::distributed::initialize();
+    #[cfg(feature = "mpi")]
+    if let Some(universe) = &universe {
+        use mpi::traits::Communicator;
+        let world = universe.world();
+        if world.size() > 1 {
+            return super::distributed::run_mesh(
+                &world,
+                input,
+                output,
+                stats_json,
+                quality_svg,
+                opts,
+                &params,
+            );
+        }
+    }
     // One pool of `--threads` threads for the whole run (`pipeline::mesh` enters the same one),
     // the quality measures of the output and its writing included.
     slivermesh::parallel::with_threads(params.threads, || {
@@ -225,6 +245,30 @@ fn run_mesh_with(
     opts: &MeshOptions,
     params: &Params,
 ) -> Result<(), String> {
+    let mesher = prepare(input, opts, params)?;
+    let MeshOutput {
+        mesh,
+        quadratic,
+        report,
+    } = mesh_with_progress(mesher)?;
+    let written = Written {
+        mesh: &mesh,
+        quadratic: quadratic.as_ref(),
+        binary: opts.binary,
+    };
+    finish(written, &report, output, stats_json, quality_svg)
+}
+
+/// Whether `input` is an existing mesh (.mesh) whose slivers are removed, rather than a domain.
+pub fn is_existing_mesh(input: &Path) -> bool {
+    input
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("mesh"))
+}
+
+/// The mesher of `slivermesh mesh`: the input read (a domain, or an existing mesh), `params`
+/// and the spacing the options choose (--size, --size-field, else automatic).
+pub fn prepare(input: &Path, opts: &MeshOptions, params: &Params) -> Result<Mesher, String> {
     if params.surface_mode == SurfaceMode::Keep
         && (opts.feature_angle.is_some() || opts.surface_distance.is_some())
     {
@@ -240,10 +284,7 @@ fn run_mesh_with(
         Some(p) => Some(io::sizefield::read_size_field(p)?),
         None => None,
     };
-    let is_mesh = input
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("mesh"));
-    let mut mesher = if is_mesh {
+    let mut mesher = if is_existing_mesh(input) {
         if opts.surface == Some(SurfaceArg::Approximate) {
             return Err(format!(
                 "{}: --surface approximate does not apply to an existing mesh (.mesh): its \
@@ -277,17 +318,7 @@ fn run_mesh_with(
         // split across the run's threads.
         mesher.set_spacing_sync(f);
     }
-    let MeshOutput {
-        mesh,
-        quadratic,
-        report,
-    } = mesh_with_progress(mesher)?;
-    let written = Written {
-        mesh: &mesh,
-        quadratic: quadratic.as_ref(),
-        binary: opts.binary,
-    };
-    finish(written, &report, output, stats_json, quality_svg)
+    Ok(mesher)
 }
 
 /// Runs `mesher` (`api::Mesher::refine_with`: the surface mode, refinement and improvement, or
@@ -335,6 +366,19 @@ fn finish(
     stats_json: Option<&Path>,
     quality_svg: Option<&Path>,
 ) -> Result<(), String> {
+    finish_with(written, report, output, stats_json, quality_svg, &[])
+}
+
+/// [`finish`], with `extra` (name, value) pairs added to the `--stats-json` object (the
+/// distributed run's `ranks`).
+pub fn finish_with(
+    written: Written,
+    report: &Report,
+    output: Option<&Path>,
+    stats_json: Option<&Path>,
+    quality_svg: Option<&Path>,
+    extra: &[(&str, serde_json::Value)],
+) -> Result<(), String> {
     let mesh = written.mesh;
     println!("{}", report.table());
     if let Some(surface) = &report.surface {
@@ -372,10 +416,24 @@ fn finish(
             fields.insert("peak_rss_mb".into(), (bytes as f64 / 1e6).into());
             fields.insert("bytes_per_tet".into(), per_tet.into());
         }
-        let text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())?;
-        std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+        write_stats_json(path, json, extra)?;
     }
     Ok(())
+}
+
+/// Writes `json` (an object) with `extra` (name, value) pairs added to `path`.
+pub fn write_stats_json(
+    path: &Path,
+    mut json: serde_json::Value,
+    extra: &[(&str, serde_json::Value)],
+) -> Result<(), String> {
+    if let Some(fields) = json.as_object_mut() {
+        for (k, v) in extra {
+            fields.insert((*k).into(), v.clone());
+        }
+    }
+    let text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())?;
+    std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))
 }
 
 /// Whether the output format has a place for per-tet cell data (.vtu).

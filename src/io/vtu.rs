@@ -14,10 +14,14 @@
 //! and then the mid-edge nodes, the cells `VTK_QUADRATIC_TETRA` (24) with the corners and the
 //! edges ab, bc, ac, ad, bd, cd (VTK's order, the mesh's own); the cell data is the same.
 //!
+//! One piece of a distributed mesh ([`write_vtu_piece`], `crate::distributed`) adds the global
+//! ids as `Int64` arrays: `PointData` `GlobalNodeId` (declared as the point `GlobalIds`) and
+//! `CellData` `GlobalCellId`; [`write_pvtu`] writes the `.pvtu` naming the pieces (no ghosts).
+//!
 //! Read: ASCII `DataArray`s only (no `binary`/`appended`/compressed data), one `Piece`, cells of
 //! type 10 only; `Points`, `connectivity`, `offsets`, `types`, the `region` cell array (tets get
-//! region 0 when it is absent) and every other `CellData` array as a named field. Point data is
-//! ignored. Errors carry the line of the offending array.
+//! region 0 when it is absent), every other `CellData` array as a named field and every scalar
+//! `PointData` array as a named point field. Errors carry the line of the offending array.
 
 use super::elements::Elements;
 use super::text::{
@@ -38,6 +42,97 @@ pub fn write_vtu(path: &Path, mesh: &TetMesh, cell_fields: &[CellField]) -> Resu
     format_vtu(&mut w, mesh, cell_fields)
         .and_then(|_| w.flush())
         .map_err(|e| write_err(path, e))
+}
+
+/// Name of the point array of global vertex ids in a piece of a distributed mesh.
+pub const GLOBAL_NODE_ID: &str = "GlobalNodeId";
+/// Name of the cell array of global tet ids in a piece of a distributed mesh.
+pub const GLOBAL_CELL_ID: &str = "GlobalCellId";
+
+/// The global ids of one piece of a distributed mesh: one per point, one per cell.
+#[derive(Debug, Clone, Copy)]
+pub struct GlobalIds<'a> {
+    pub points: &'a [i64],
+    pub cells: &'a [i64],
+}
+
+/// Writes one piece of a distributed mesh: [`write_vtu`]'s file plus the global ids
+/// ([`GLOBAL_NODE_ID`] point data, [`GLOBAL_CELL_ID`] cell data).
+pub fn write_vtu_piece(
+    path: &Path,
+    mesh: &TetMesh,
+    ids: GlobalIds,
+    cell_fields: &[CellField],
+) -> Result<(), IoError> {
+    check_mesh(mesh, &field_lens(cell_fields)).map_err(|e| with_path(e, path))?;
+    if ids.points.len() != mesh.vertices.len() || ids.cells.len() != mesh.tets.len() {
+        return Err(with_path(
+            err_file(format!(
+                "{} global point ids for {} points, {} global cell ids for {} cells",
+                ids.points.len(),
+                mesh.vertices.len(),
+                ids.cells.len(),
+                mesh.tets.len()
+            )),
+            path,
+        ));
+    }
+    let mut w = create(path)?;
+    format_elements(&mut w, &Elements::new(mesh, None), cell_fields, Some(ids))
+        .and_then(|_| w.flush())
+        .map_err(|e| write_err(path, e))
+}
+
+/// Writes the `.pvtu` of a distributed mesh whose pieces ([`write_vtu_piece`], `cell_fields`
+/// the names of their Float64 cell fields) are `pieces`, paths relative to the `.pvtu`'s folder.
+pub fn write_pvtu(path: &Path, pieces: &[String], cell_fields: &[&str]) -> Result<(), IoError> {
+    let mut w = create(path)?;
+    format_pvtu(&mut w, pieces, cell_fields)
+        .and_then(|_| w.flush())
+        .map_err(|e| write_err(path, e))
+}
+
+/// The `.pvtu` document of [`write_pvtu`]: the arrays of [`write_vtu_piece`], in its order.
+pub fn format_pvtu<W: Write>(
+    w: &mut W,
+    pieces: &[String],
+    cell_fields: &[&str],
+) -> std::io::Result<()> {
+    writeln!(w, "<?xml version=\"1.0\"?>")?;
+    writeln!(
+        w,
+        "<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" \
+         header_type=\"UInt64\">"
+    )?;
+    // No ghost cells: every tet is in exactly one piece.
+    writeln!(w, "<PUnstructuredGrid GhostLevel=\"0\">")?;
+    writeln!(w, "<PPointData GlobalIds=\"{GLOBAL_NODE_ID}\">")?;
+    writeln!(w, "<PDataArray type=\"Int64\" Name=\"{GLOBAL_NODE_ID}\"/>")?;
+    writeln!(w, "</PPointData>")?;
+    writeln!(
+        w,
+        "<PCellData Scalars=\"region\" GlobalIds=\"{GLOBAL_CELL_ID}\">"
+    )?;
+    writeln!(w, "<PDataArray type=\"Int32\" Name=\"region\"/>")?;
+    writeln!(w, "<PDataArray type=\"Int64\" Name=\"{GLOBAL_CELL_ID}\"/>")?;
+    for name in cell_fields {
+        writeln!(
+            w,
+            "<PDataArray type=\"Float64\" Name=\"{}\"/>",
+            xml_escape(name)
+        )?;
+    }
+    writeln!(w, "</PCellData>")?;
+    writeln!(w, "<PPoints>")?;
+    writeln!(
+        w,
+        "<PDataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\"/>"
+    )?;
+    writeln!(w, "</PPoints>")?;
+    for piece in pieces {
+        writeln!(w, "<Piece Source=\"{}\"/>", xml_escape(piece))?;
+    }
+    writeln!(w, "</PUnstructuredGrid>\n</VTKFile>")
 }
 
 /// Writes `mesh` with its mid-edge nodes and `cell_fields` as a `.vtu` file of
@@ -132,7 +227,7 @@ pub fn format_vtu<W: Write>(
     cell_fields: &[CellField],
 ) -> std::io::Result<()> {
     check_mesh_io(mesh, &field_lens(cell_fields))?;
-    format_elements(w, &Elements::new(mesh, None), cell_fields)
+    format_elements(w, &Elements::new(mesh, None), cell_fields, None)
 }
 
 /// Writes `mesh` with its mid-edge nodes as `VTK_QUADRATIC_TETRA` cells in `.vtu` format:
@@ -146,7 +241,7 @@ pub fn format_vtu_quadratic<W: Write>(
 ) -> std::io::Result<()> {
     check_mesh_io(mesh, &field_lens(cell_fields))?;
     check_quadratic_io(mesh, quadratic)?;
-    format_elements(w, &Elements::new(mesh, Some(quadratic)), cell_fields)
+    format_elements(w, &Elements::new(mesh, Some(quadratic)), cell_fields, None)
 }
 
 /// The (name, length) of each cell field, for the mesh checks.
@@ -161,6 +256,7 @@ fn format_elements<W: Write>(
     w: &mut W,
     el: &Elements,
     cell_fields: &[CellField],
+    ids: Option<GlobalIds>,
 ) -> std::io::Result<()> {
     let mesh = el.mesh;
     let nt = mesh.tets.len();
@@ -198,13 +294,35 @@ fn format_elements<W: Write>(
     let types = vec![ty; nt];
     write_rows(w, &types, 32, push_int)?;
     writeln!(w, "</DataArray>\n</Cells>")?;
-    writeln!(w, "<CellData Scalars=\"region\">")?;
+    if let Some(ids) = ids {
+        writeln!(w, "<PointData GlobalIds=\"{GLOBAL_NODE_ID}\">")?;
+        writeln!(
+            w,
+            "<DataArray type=\"Int64\" Name=\"{GLOBAL_NODE_ID}\" format=\"ascii\">"
+        )?;
+        write_rows(w, ids.points, 16, push_int)?;
+        writeln!(w, "</DataArray>\n</PointData>")?;
+        writeln!(
+            w,
+            "<CellData Scalars=\"region\" GlobalIds=\"{GLOBAL_CELL_ID}\">"
+        )?;
+    } else {
+        writeln!(w, "<CellData Scalars=\"region\">")?;
+    }
     writeln!(
         w,
         "<DataArray type=\"Int32\" Name=\"region\" format=\"ascii\">"
     )?;
     write_rows(w, &mesh.tet_regions, 16, push_int)?;
     writeln!(w, "</DataArray>")?;
+    if let Some(ids) = ids {
+        writeln!(
+            w,
+            "<DataArray type=\"Int64\" Name=\"{GLOBAL_CELL_ID}\" format=\"ascii\">"
+        )?;
+        write_rows(w, ids.cells, 16, push_int)?;
+        writeln!(w, "</DataArray>")?;
+    }
     for f in cell_fields {
         writeln!(
             w,
@@ -225,6 +343,8 @@ fn format_elements<W: Write>(
 pub struct VtuData {
     pub mesh: TetMesh,
     pub cell_fields: Vec<(String, Vec<f64>)>,
+    /// Scalar point arrays (e.g. a distributed piece's `GlobalNodeId`).
+    pub point_fields: Vec<(String, Vec<f64>)>,
 }
 
 /// Reads a `.vtu` file written by [`write_vtu`] (or any file in the documented subset).
@@ -512,6 +632,17 @@ pub fn parse_vtu(text: &str) -> Result<VtuData, IoError> {
             cell_fields.push((a.name.clone(), vals));
         }
     }
+    let mut point_fields = Vec::new();
+    for a in arrays
+        .iter()
+        .filter(|a| a.section == "PointData" && a.components == 1)
+    {
+        let vals = numbers(a, np, |w, l| {
+            w.parse::<f64>()
+                .map_err(|_| err_at(l, format!("bad number '{w}' in point array")))
+        })?;
+        point_fields.push((a.name.clone(), vals));
+    }
     Ok(VtuData {
         mesh: TetMesh {
             vertices,
@@ -521,12 +652,46 @@ pub fn parse_vtu(text: &str) -> Result<VtuData, IoError> {
             boundary_markers: Vec::new(),
         },
         cell_fields,
+        point_fields,
     })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn piece_carries_global_ids_and_the_pvtu_names_pieces() {
+        let mesh = tet_mesh();
+        let points: Vec<i64> = (0..mesh.vertices.len() as i64).map(|i| 10 + i).collect();
+        let cells: Vec<i64> = (0..mesh.tets.len() as i64).map(|i| 7 + i).collect();
+        let ids = GlobalIds {
+            points: &points,
+            cells: &cells,
+        };
+        let mut buf = Vec::new();
+        format_elements(&mut buf, &Elements::new(&mesh, None), &[], Some(ids)).unwrap();
+        let d = parse_vtu(std::str::from_utf8(&buf).unwrap()).unwrap();
+        assert_eq!(d.mesh, mesh);
+        let as_f64 = |v: &[i64]| v.iter().map(|&x| x as f64).collect::<Vec<_>>();
+        assert_eq!(
+            d.point_fields,
+            vec![(GLOBAL_NODE_ID.into(), as_f64(&points))]
+        );
+        assert_eq!(d.cell_fields, vec![(GLOBAL_CELL_ID.into(), as_f64(&cells))]);
+        let mut p = Vec::new();
+        let names = ["a_0.vtu".to_string(), "a_1.vtu".to_string()];
+        format_pvtu(&mut p, &names, &["q"]).unwrap();
+        let p = String::from_utf8(p).unwrap();
+        assert!(
+            p.contains("<Piece Source=\"a_0.vtu\"/>\n<Piece Source=\"a_1.vtu\"/>"),
+            "{p}"
+        );
+        assert!(
+            p.contains("GlobalIds=\"GlobalNodeId\"") && p.contains("Name=\"q\""),
+            "{p}"
+        );
+    }
 
     fn tet_mesh() -> TetMesh {
         TetMesh {

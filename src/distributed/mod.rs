@@ -1,0 +1,132 @@
+//! Distributed meshing on MPI (cargo feature `mpi`): every rank of a communicator meshes one
+//! part of `crate::partition`'s plan, then the parts are numbered globally and written.
+//!
+//! - [`mesh_on`]: `partition::plan` (the same on every rank) and `partition::mesh_part` for
+//!   this rank, then [`numbering::number`]: global vertex and tet ids, and the vertices shared
+//!   with each neighbour rank.
+//! - [`output`]: one `.vtu` piece per rank with the global ids and the `.pvtu` naming them,
+//!   or the parts gathered on rank 0 into one mesh for any writer.
+//! - [`gather_stats`]: each rank's tets, seconds and peak memory on rank 0.
+//!
+//! Every function here is collective: all ranks call it, in the same order. A failure on one
+//! rank makes every rank return an error ([`collect::agree`]), so none waits forever.
+
+pub mod collect;
+pub mod numbering;
+pub mod output;
+
+use crate::mesh::TetMesh;
+use crate::plc::PlcInput;
+use crate::run::params::Params;
+use crate::run::report::Report;
+use crate::run::spacing::Spacing;
+use mpi::traits::*;
+pub use numbering::Numbering;
+
+/// A failed distributed step, on this rank (`here`) or on another one.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Error {
+    pub message: String,
+    /// Whether this rank failed (else another rank did, and `message` names it).
+    pub here: bool,
+}
+
+impl Error {
+    /// This rank's failure.
+    pub fn here(message: impl Into<String>) -> Self {
+        Error {
+            message: message.into(),
+            here: true,
+        }
+    }
+
+    /// A failure every rank finds alike (rank 0's copy is the one to print).
+    pub fn everywhere(message: impl Into<String>) -> Self {
+        Error {
+            message: message.into(),
+            here: false,
+        }
+    }
+
+    /// Rank `rank` failed; this one stops with it.
+    pub fn elsewhere(rank: i32) -> Self {
+        Error {
+            message: format!("rank {rank} failed (its error is printed by that rank)"),
+            here: false,
+        }
+    }
+}
+
+impl std::fmt::Display for Error {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for Error {}
+
+/// One rank's share of a distributed run.
+#[derive(Debug, Clone)]
+pub struct Part {
+    pub rank: usize,
+    /// The number of ranks (parts).
+    pub size: usize,
+    /// This rank's part: local vertex ids from 0, its tets and regions, the domain boundary
+    /// triangles that are faces of its tets.
+    pub mesh: TetMesh,
+    /// The part's report (`partition::mesh_part`).
+    pub report: Report,
+    pub numbering: Numbering,
+}
+
+/// Meshes `input` on all ranks of `comm` (collective): plans the partition into one part per
+/// rank, meshes this rank's part and numbers it globally.
+pub fn mesh_on<C: Communicator>(
+    comm: &C,
+    input: &PlcInput,
+    params: &Params,
+    spacing: Option<&dyn Spacing>,
+) -> Result<Part, Error> {
+    let rank = comm.rank() as usize;
+    let size = comm.size() as usize;
+    let meshed = crate::partition::plan(input, params, spacing, size)
+        .and_then(|plan| crate::partition::mesh_part(&plan, rank))
+        .map_err(|e| Error::here(format!("rank {rank}: {e}")));
+    let (mesh, report) = collect::agree(comm, meshed)?;
+    let numbering = numbering::number(comm, &mesh)?;
+    Ok(Part {
+        rank,
+        size,
+        mesh,
+        report,
+        numbering,
+    })
+}
+
+/// What rank 0 reports of each rank.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct RankStats {
+    pub tets: u64,
+    /// Wall time of the rank's run.
+    pub seconds: f64,
+    /// Peak resident memory of the rank's process, in MB (0 where unknown).
+    pub peak_rss_mb: f64,
+}
+
+/// Every rank's `stats` on rank 0, in rank order (`None` on the other ranks; collective).
+pub fn gather_stats<C: Communicator>(
+    comm: &C,
+    stats: RankStats,
+) -> Result<Option<Vec<RankStats>>, Error> {
+    let row = [stats.tets as f64, stats.seconds, stats.peak_rss_mb];
+    let rows = collect::gather_varcount(comm, &row[..], "statistics")?;
+    Ok(rows.map(|(rows, _)| {
+        rows.chunks_exact(3)
+            .map(|r| RankStats {
+                tets: r[0] as u64,
+                seconds: r[1],
+                peak_rss_mb: r[2],
+            })
+            .collect()
+    }))
+}

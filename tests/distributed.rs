@@ -1,0 +1,255 @@
+//! Distributed meshing end to end (cargo feature `mpi`): the built binary under
+//! `mpirun -np 2` and `-np 3`, writing a `.pvtu` and a mesh gathered on rank 0, checked against
+//! the serial run. Skipped, with a message, where `mpirun` is not on PATH.
+#![cfg(feature = "mpi")]
+
+use slivermesh::geom::orient3d;
+use slivermesh::io::vtu::{read_vtu, GLOBAL_CELL_ID, GLOBAL_NODE_ID};
+use slivermesh::TetMesh;
+use std::collections::{HashMap, HashSet};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const BIN: &str = env!("CARGO_BIN_EXE_slivermesh");
+
+fn model(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("models/poly")
+        .join(name)
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!(
+        "slivermesh-distributed-{}-{name}",
+        std::process::id()
+    ));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn has_mpirun() -> bool {
+    Command::new("mpirun")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success())
+}
+
+/// Runs `slivermesh mesh ARGS`, under `mpirun -np N` when `np` is given; panics with its
+/// output on failure.
+fn run(np: Option<usize>, args: &[&str]) -> String {
+    let mut cmd = match np {
+        Some(n) => {
+            let mut c = Command::new("mpirun");
+            c.args([
+                "--oversubscribe",
+                "--allow-run-as-root",
+                "-np",
+                &n.to_string(),
+                BIN,
+            ]);
+            c
+        }
+        None => Command::new(BIN),
+    };
+    // One thread per rank: the ranks share this machine's cores.
+    let out = cmd
+        .arg("mesh")
+        .args(args)
+        .args(["--threads", "1"])
+        .output()
+        .unwrap();
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(out.status.success(), "{np:?} {args:?} failed:\n{text}");
+    text
+}
+
+fn sorted<const N: usize>(mut f: [u32; N]) -> [u32; N] {
+    f.sort_unstable();
+    f
+}
+
+fn volume(m: &TetMesh) -> f64 {
+    m.tets
+        .iter()
+        .map(|t| {
+            let [a, b, c, d] = t.map(|v| m.vertices[v as usize]);
+            (b - a).dot((c - a).cross(d - a)) / 6.0
+        })
+        .sum()
+}
+
+/// Every face in at most two tets; the faces of one tet are boundary triangles, and a boundary
+/// triangle in two tets separates two regions; every tet positively oriented (exact).
+fn check_conforming(m: &TetMesh, what: &str) {
+    let mut faces: HashMap<[u32; 3], Vec<usize>> = HashMap::new();
+    for (i, t) in m.tets.iter().enumerate() {
+        let [a, b, c, d] = t.map(|v| m.vertices[v as usize]);
+        assert!(
+            orient3d(a, b, c, d) > 0.0,
+            "{what}: tet {i} {t:?} inverted or flat"
+        );
+        for skip in 0..4 {
+            let f: Vec<u32> = (0..4).filter(|&k| k != skip).map(|k| t[k]).collect();
+            faces.entry(sorted([f[0], f[1], f[2]])).or_default().push(i);
+        }
+    }
+    let boundary: HashSet<[u32; 3]> = m.boundary.iter().map(|&b| sorted(b)).collect();
+    assert_eq!(
+        boundary.len(),
+        m.boundary.len(),
+        "{what}: a boundary triangle twice"
+    );
+    for (f, tets) in &faces {
+        assert!(tets.len() <= 2, "{what}: face {f:?} in {} tets", tets.len());
+        if tets.len() == 1 {
+            assert!(
+                boundary.contains(f),
+                "{what}: face {f:?} of one tet is no boundary triangle"
+            );
+        }
+    }
+    for b in &boundary {
+        let tets = faces
+            .get(b)
+            .unwrap_or_else(|| panic!("{what}: boundary {b:?} is no face"));
+        if tets.len() == 2 {
+            let (r0, r1) = (m.tet_regions[tets[0]], m.tet_regions[tets[1]]);
+            assert_ne!(r0, r1, "{what}: boundary {b:?} inside region {r0}");
+        }
+    }
+}
+
+/// The `Source` of each `Piece` of a `.pvtu`.
+fn pieces(pvtu: &Path) -> Vec<String> {
+    let text = std::fs::read_to_string(pvtu).unwrap();
+    text.split("<Piece Source=\"")
+        .skip(1)
+        .map(|s| s[..s.find('"').unwrap()].to_string())
+        .collect()
+}
+
+fn check_distributed(np: usize, name: &str, size: &str) {
+    let dir = scratch(&format!("{name}-{np}"));
+    let input = model(name);
+    let input = input.to_str().unwrap();
+    let serial = dir.join("serial.mesh");
+    run(
+        None,
+        &[input, "-o", serial.to_str().unwrap(), "--size", size],
+    );
+    let serial = slivermesh::io::read_mesh(&serial).unwrap();
+
+    // Gathered on rank 0, written by the serial writer.
+    let gathered = dir.join("gathered.mesh");
+    let stats = dir.join("stats.json");
+    let log = run(
+        Some(np),
+        &[
+            input,
+            "-o",
+            gathered.to_str().unwrap(),
+            "--size",
+            size,
+            "--stats-json",
+            stats.to_str().unwrap(),
+        ],
+    );
+    assert!(
+        log.contains(&format!("distributed run: {np} ranks")),
+        "{log}"
+    );
+    let mesh = slivermesh::io::read_mesh(&gathered).unwrap();
+    check_conforming(&mesh, &format!("{name} on {np} ranks"));
+    let (v, v0) = (volume(&mesh), volume(&serial));
+    assert!(
+        (v - v0).abs() <= 1e-9 * v0.abs(),
+        "volume {v} vs serial {v0}"
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    let ranks = json["ranks"].as_array().expect("ranks");
+    assert_eq!(ranks.len(), np);
+    let tets: u64 = ranks.iter().map(|r| r["tets"].as_u64().unwrap()).sum();
+    assert_eq!(tets as usize, mesh.tets.len());
+    for r in ranks {
+        assert!(r["seconds"].as_f64().unwrap() > 0.0 && r["peak_rss_mb"].as_f64().unwrap() > 0.0);
+    }
+    assert_eq!(
+        json["global_vertices"].as_u64(),
+        Some(mesh.vertices.len() as u64)
+    );
+
+    // One piece per rank, named relative to the .pvtu, with global ids 0..N-1 without gaps.
+    let pvtu = dir.join("parts.pvtu");
+    run(
+        Some(np),
+        &[input, "-o", pvtu.to_str().unwrap(), "--size", size],
+    );
+    let names = pieces(&pvtu);
+    assert_eq!(
+        names,
+        (0..np)
+            .map(|r| format!("parts_{r}.vtu"))
+            .collect::<Vec<_>>()
+    );
+    let mut coords: HashMap<u64, [u64; 3]> = HashMap::new();
+    let mut cells = Vec::new();
+    let mut piece_tets = 0;
+    for n in &names {
+        assert!(!n.contains('/') && !Path::new(n).is_absolute(), "{n}");
+        let piece = read_vtu(&dir.join(n)).unwrap();
+        let field = |fields: &[(String, Vec<f64>)], key: &str| -> Vec<u64> {
+            let (_, v) = fields.iter().find(|(k, _)| k == key).expect(key);
+            v.iter().map(|&x| x as u64).collect()
+        };
+        let node_ids = field(&piece.point_fields, GLOBAL_NODE_ID);
+        cells.extend(field(&piece.cell_fields, GLOBAL_CELL_ID));
+        piece_tets += piece.mesh.tets.len();
+        for (&id, p) in node_ids.iter().zip(&piece.mesh.vertices) {
+            let bits = [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+            // A vertex in several pieces has one id and the same coordinates in each.
+            assert_eq!(
+                *coords.entry(id).or_insert(bits),
+                bits,
+                "global vertex {id}"
+            );
+        }
+    }
+    let mut ids: Vec<u64> = coords.keys().copied().collect();
+    ids.sort_unstable();
+    assert_eq!(ids, (0..mesh.vertices.len() as u64).collect::<Vec<_>>());
+    // The pieces' numbering is the gathered mesh's.
+    for (id, bits) in &coords {
+        let p = mesh.vertices[*id as usize];
+        assert_eq!(*bits, [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]);
+    }
+    cells.sort_unstable();
+    assert_eq!(piece_tets, mesh.tets.len());
+    assert_eq!(cells, (0..mesh.tets.len() as u64).collect::<Vec<_>>());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn cube_on_two_and_three_ranks() {
+    if !has_mpirun() {
+        println!("skipped: mpirun is not on PATH");
+        return;
+    }
+    for np in [2, 3] {
+        check_distributed(np, "cube.poly", "0.15");
+    }
+}
+
+#[test]
+fn two_materials_on_three_ranks() {
+    if !has_mpirun() {
+        println!("skipped: mpirun is not on PATH");
+        return;
+    }
+    check_distributed(3, "two_materials.poly", "0.1");
+}
