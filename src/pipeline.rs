@@ -99,7 +99,7 @@ fn remove_slivers_here(
 /// The improvement pass (`improve::finish`) on a refined mesh, recorded in its `report`: the
 /// shape figures re-measured when the mesh changed (the size figures stay the refinement's),
 /// the dihedral range before, the stats and the time.
-fn improve(
+pub(crate) fn improve(
     mesh: TetMesh,
     report: &mut Report,
     input: Option<&PlcInput>,

@@ -131,9 +131,14 @@ fn two_halves_meshed_alone_conform_on_their_frozen_interface() {
     for left in [true, false] {
         let (input, n_frozen) = half(left, n);
         let frozen: Vec<u32> = (0..n_frozen as u32).collect();
-        let (mesh, report) =
-            slivermesh::refine::mesh_frozen(&input, &params, Some(&spacing), &frozen)
-                .unwrap_or_else(|e| panic!("left {left}: {e}"));
+        let (mesh, report) = slivermesh::refine::mesh_frozen(
+            &input,
+            &params,
+            Some(&spacing),
+            &frozen,
+            slivermesh::refine::Unseeded::Domain,
+        )
+        .unwrap_or_else(|e| panic!("left {left}: {e}"));
         common::check_orientation(&mesh);
         // The interface keeps exactly its triangles.
         let on_interface: usize = mesh.boundary_markers.iter().filter(|&&m| m == 7).count();

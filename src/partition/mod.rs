@@ -5,43 +5,81 @@
 //! deterministic); [`mesh_part`] then meshes one part. The parts' meshes share their interface
 //! vertices bit for bit (the same coordinates), so gluing them by coordinates gives one
 //! conforming mesh; each part's `boundary` holds only its share of the domain's boundary and
-//! interface facets (not the faces between parts).
+//! interface facets (not the faces between parts). docs/distributed.md has the scheme:
 //!
-//! FIRST STEP (to be replaced in this session): the plan meshes the whole domain serially and
-//! each part is a contiguous run of its tets in Hilbert order of their centroids.
+//! 1. a coarse mesh of the domain (`coarse.rs`), its tets cut into parts of equal estimated
+//!    final size along the Hilbert order of their centroids;
+//! 2. the band of coarse tets around the interfaces meshed once with the interfaces as
+//!    internal facets (`band.rs`): their triangles, sized for both sides, and the band's
+//!    inner vertices;
+//! 3. each part's PLC (`part_plc.rs`): its coarse tets' boundary with the band's interface
+//!    triangles as frozen facets, the band's vertices on its side as seeds; meshed alone
+//!    (`refine::mesh_frozen`) and improved with its boundary fixed.
 
-use crate::delaunay::hilbert::hilbert_sort;
+mod band;
+mod coarse;
+mod part_plc;
+
 use crate::mesh::TetMesh;
 use crate::plc::PlcInput;
+use crate::refine::AutoSpacing;
 use crate::run::error::MeshError;
 use crate::run::params::{Params, SurfaceMode};
 use crate::run::report::Report;
 use crate::run::spacing::Spacing;
-use glam::DVec3;
+use band::Band;
+use coarse::Coarse;
 
-/// What every part needs to mesh its share: the same on every part.
-pub struct Plan {
-    parts: usize,
-    whole: TetMesh,
-    report: Report,
-    /// Tets of each part (indices into `whole.tets`).
-    part_tets: Vec<Vec<u32>>,
+/// Marker of the interface triangles in a part's PLC (left out of its output).
+const INTERFACE_MARKER: i32 = i32::MIN + 1;
+
+/// The spacing every part refines for: the caller's, or the automatic one of the whole
+/// domain (a part's own boundary would give another).
+enum PartSpacing<'s> {
+    Given(&'s dyn Spacing),
+    Auto(AutoSpacing),
 }
 
-impl Plan {
+impl PartSpacing<'_> {
+    fn get(&self) -> &dyn Spacing {
+        match self {
+            PartSpacing::Given(s) => *s,
+            PartSpacing::Auto(a) => a,
+        }
+    }
+}
+
+/// What every part needs to mesh its share: the same on every part.
+pub struct Plan<'s> {
+    params: Params,
+    spacing: PartSpacing<'s>,
+    coarse: Coarse,
+    band: Band,
+}
+
+impl Plan<'_> {
     /// The number of parts.
     pub fn parts(&self) -> usize {
-        self.parts
+        self.coarse.parts
+    }
+
+    /// Coarse tets, band tets and band vertices (for the report).
+    pub fn sizes(&self) -> (usize, usize, usize) {
+        (
+            self.coarse.mesh.tets.len(),
+            self.band.n_coarse_tets,
+            self.band.mesh.vertices.len(),
+        )
     }
 }
 
 /// Prepares the partition of `input` into `parts` parts (keep mode only for now).
-pub fn plan(
+pub fn plan<'s>(
     input: &PlcInput,
     params: &Params,
-    spacing: Option<&dyn Spacing>,
+    spacing: Option<&'s dyn Spacing>,
     parts: usize,
-) -> Result<Plan, MeshError> {
+) -> Result<Plan<'s>, MeshError> {
     if parts == 0 {
         return Err(MeshError::InvalidInput(
             "a partition needs at least one part".into(),
@@ -52,72 +90,51 @@ pub fn plan(
             "partitioned meshing supports the keep surface mode only (so far)".into(),
         ));
     }
-    let (whole, _, report) = crate::pipeline::mesh(input, params, spacing, None)?;
-    let centroids: Vec<DVec3> = whole
-        .tets
-        .iter()
-        .map(|t| t.iter().map(|&v| whole.vertices[v as usize]).sum::<DVec3>() / 4.0)
-        .collect();
-    let mut order: Vec<u32> = (0..whole.tets.len() as u32).collect();
-    hilbert_sort(&centroids, &mut order);
-    let n = order.len();
-    let part_tets = (0..parts)
-        .map(|k| order[k * n / parts..(k + 1) * n / parts].to_vec())
-        .collect();
+    let spacing = match spacing {
+        Some(s) => PartSpacing::Given(s),
+        None => PartSpacing::Auto(crate::refine::auto_spacing(input, params)?),
+    };
+    let coarse = Coarse::new(input, params, spacing.get(), parts)?;
+    let band = Band::new(&coarse, params, spacing.get())?;
     Ok(Plan {
-        parts,
-        whole,
-        report,
-        part_tets,
+        params: params.clone(),
+        spacing,
+        coarse,
+        band,
     })
 }
 
 /// Meshes part `part` of `plan`: its tets, vertices numbered from 0, region attributes, and
-/// the domain's boundary triangles (with markers) that are faces of its tets.
+/// the domain's boundary and region-interface triangles (with markers) that are faces of its
+/// tets; the interface triangles it shares with other parts are the band's.
 pub fn mesh_part(plan: &Plan, part: usize) -> Result<(TetMesh, Report), MeshError> {
-    let tets = plan.part_tets.get(part).ok_or_else(|| {
-        MeshError::InvalidInput(format!("part {part} of a plan of {} parts", plan.parts))
-    })?;
-    let whole = &plan.whole;
-    let mut local = vec![u32::MAX; whole.vertices.len()];
-    let mut mesh = TetMesh::default();
-    for &t in tets {
-        let tv = whole.tets[t as usize].map(|v| {
-            if local[v as usize] == u32::MAX {
-                local[v as usize] = mesh.vertices.len() as u32;
-                mesh.vertices.push(whole.vertices[v as usize]);
-            }
-            local[v as usize]
-        });
-        mesh.tets.push(tv);
-        mesh.tet_regions.push(whole.tet_regions[t as usize]);
+    if part >= plan.parts() {
+        return Err(MeshError::InvalidInput(format!(
+            "part {part} of a plan of {} parts",
+            plan.parts()
+        )));
     }
-    let mut faces = rustc_hash::FxHashSet::default();
-    for t in &mesh.tets {
-        for skip in 0..4 {
-            let mut f = [0; 3];
-            let mut k = 0;
-            for (i, &v) in t.iter().enumerate() {
-                if i != skip {
-                    f[k] = v;
-                    k += 1;
-                }
-            }
-            f.sort_unstable();
-            faces.insert(f);
-        }
-    }
-    for (b, &m) in whole.boundary.iter().zip(&whole.boundary_markers) {
-        let lb = b.map(|v| local[v as usize]);
-        if lb.contains(&u32::MAX) {
-            continue;
-        }
-        let mut key = lb;
-        key.sort_unstable();
-        if faces.contains(&key) {
-            mesh.boundary.push(lb);
-            mesh.boundary_markers.push(m);
-        }
-    }
-    Ok((mesh, plan.report.clone()))
+    let (input, frozen) = part_plc::build(&plan.coarse, &plan.band, part)?;
+    let refine_params = Params {
+        improve: false,
+        ..plan.params.clone()
+    };
+    let (mesh, mut report) = crate::refine::mesh_frozen(
+        &input,
+        &refine_params,
+        Some(plan.spacing.get()),
+        &frozen,
+        crate::refine::Unseeded::Hole,
+    )?;
+    // Improved with its whole boundary fixed: the interface must stay the band's, and a part
+    // has no facet description of the domain's sides to slide on.
+    let mut mesh = crate::pipeline::improve(mesh, &mut report, None, &plan.params)?;
+    let keep: Vec<bool> = (mesh.boundary_markers.iter())
+        .map(|&m| m != INTERFACE_MARKER)
+        .collect();
+    let mut k = keep.iter();
+    mesh.boundary.retain(|_| *k.next().unwrap_or(&true));
+    mesh.boundary_markers.retain(|&m| m != INTERFACE_MARKER);
+    report.measure_regions(&mesh);
+    Ok((mesh, report))
 }

@@ -38,15 +38,12 @@ pub fn remove_slivers(existing: &TetMesh, params: &Params) -> Result<(TetMesh, R
     let unbounded = ConstantSpacing(1e3 * (hi - lo).length().max(1e-300));
     // The angles between boundary triangles are not input features: shape bounds are
     // enforced everywhere (the vertex budget still bounds the work).
-    mesh_domain(
-        &input,
-        params,
-        Some(&unbounded),
-        None,
-        super::SmallAngles::None,
-        Unseeded::Hole,
-        &[],
-    )
+    let choices = super::Choices {
+        small_angles: super::SmallAngles::None,
+        unseeded: Unseeded::Hole,
+        ..super::Choices::plc()
+    };
+    mesh_domain(&input, params, Some(&unbounded), None, choices)
 }
 
 fn invalid(msg: String) -> MeshError {
@@ -110,6 +107,16 @@ fn check_consistent(m: &TetMesh) -> Result<(), MeshError> {
 }
 
 fn plc_of_mesh(m: &TetMesh) -> Result<PlcInput, MeshError> {
+    plc_of_mesh_except(m, &|_| false)
+}
+
+/// The PLC of a tet set as [`remove_slivers`] builds it, except that the faces of one tet for
+/// which `left_open` (of the sorted vertex triple) holds are no facets: the caller closes the
+/// surface there with facets of its own (a partition's refined interface).
+pub(crate) fn plc_of_mesh_except(
+    m: &TetMesh,
+    left_open: &dyn Fn(&[u32; 3]) -> bool,
+) -> Result<PlcInput, MeshError> {
     check_consistent(m)?;
     // Sorted face -> the tets sharing it.
     let mut face_tets: FxHashMap<[u32; 3], FaceTets> = FxHashMap::default();
@@ -135,6 +142,7 @@ fn plc_of_mesh(m: &TetMesh) -> Result<PlcInput, MeshError> {
     // Facet triangles: listed ones first (file order, first marker of a duplicate wins), then
     // the missing boundary and interface faces in tet order.
     let mut is_facet: FxHashSet<[u32; 3]> = FxHashSet::default();
+    let mut open_edges: FxHashSet<(u32, u32)> = FxHashSet::default();
     let mut triangles: Vec<([u32; 3], i32)> = vec![];
     for (k, (&t, &marker)) in m.boundary.iter().zip(&m.boundary_markers).enumerate() {
         let key = sorted3(t);
@@ -151,8 +159,15 @@ fn plc_of_mesh(m: &TetMesh) -> Result<PlcInput, MeshError> {
         for f in faces(t) {
             let key = sorted3(f);
             let ft = face_tets[&key];
+            let open = ft.second.is_none() && left_open(&key);
+            if open {
+                for k in 0..3 {
+                    let (u, v) = (key[k], key[(k + 1) % 3]);
+                    open_edges.insert((u.min(v), u.max(v)));
+                }
+            }
             let needed = match ft.second {
-                None => true,
+                None => !open,
                 Some(s) => m.tet_regions[ft.first as usize] != m.tet_regions[s as usize],
             };
             if needed && is_facet.insert(key) {
@@ -162,7 +177,7 @@ fn plc_of_mesh(m: &TetMesh) -> Result<PlcInput, MeshError> {
     }
 
     let regions = region_seeds(m, &face_tets, &is_facet);
-    let facets = merge_flat_patches(&m.vertices, triangles);
+    let facets = merge_flat_patches(&m.vertices, triangles, &open_edges);
     Ok(PlcInput {
         vertices: m.vertices.clone(),
         facets,
@@ -227,9 +242,18 @@ fn strictly_inside(p: [DVec3; 4], x: DVec3) -> bool {
 /// merge crosses a marker change or an edge where a third facet (an interface) meets. A patch
 /// whose own triangles share an edge another facet also uses (an interface ending inside a
 /// flat side) is left as triangles: merging would drop that edge.
-fn merge_flat_patches(vertices: &[DVec3], mut triangles: Vec<([u32; 3], i32)>) -> Vec<Facet> {
+///
+/// `other_edges`: edges of facets the caller adds (they count as a third user).
+fn merge_flat_patches(
+    vertices: &[DVec3],
+    mut triangles: Vec<([u32; 3], i32)>,
+    other_edges: &FxHashSet<(u32, u32)>,
+) -> Vec<Facet> {
     orient_by_largest_normal_component(vertices, &mut triangles);
     let mut edge_users: FxHashMap<(u32, u32), Vec<u32>> = FxHashMap::default();
+    for &e in other_edges {
+        edge_users.entry(e).or_default().push(u32::MAX);
+    }
     for (i, (t, _)) in triangles.iter().enumerate() {
         for k in 0..3 {
             let (u, v) = (t[k], t[(k + 1) % 3]);
@@ -300,6 +324,9 @@ fn flat_patches(
     let mut uf = UnionFind::new(triangles.len());
     for users in edge_users.values() {
         if let &[f, g] = &users[..] {
+            if f == u32::MAX || g == u32::MAX {
+                continue; // an edge of a facet the caller adds
+            }
             let ((tf, mf), (tg, mg)) = (triangles[f as usize], triangles[g as usize]);
             let [a, b, c] = tf.map(|v| vertices[v as usize]);
             let coplanar = tg
@@ -381,7 +408,11 @@ mod tests {
     #[test]
     fn flat_patch_with_one_marker_is_merged_keeping_it() {
         // (0,3,2) is the other orientation: reoriented before merging.
-        let f = merge_flat_patches(&square(), vec![([0, 1, 2], 5), ([0, 3, 2], 5)]);
+        let f = merge_flat_patches(
+            &square(),
+            vec![([0, 1, 2], 5), ([0, 3, 2], 5)],
+            &FxHashSet::default(),
+        );
         assert_eq!(f.len(), 1);
         assert_eq!(f[0].polygons[0].len(), 4);
         assert_eq!(f[0].marker, 5);
@@ -389,7 +420,11 @@ mod tests {
 
     #[test]
     fn marker_change_is_not_merged() {
-        let f = merge_flat_patches(&square(), vec![([0, 1, 2], 5), ([0, 2, 3], 6)]);
+        let f = merge_flat_patches(
+            &square(),
+            vec![([0, 1, 2], 5), ([0, 2, 3], 6)],
+            &FxHashSet::default(),
+        );
         let markers: Vec<i32> = f.iter().map(|f| f.marker).collect();
         assert_eq!(markers, vec![5, 6]);
     }
@@ -419,12 +454,15 @@ mod tests {
     #[test]
     fn fin_across_a_flat_ring_is_not_merged_away() {
         let (mut v, mut t) = ring();
-        assert_eq!(merge_flat_patches(&v, t.clone()).len(), 1);
+        assert_eq!(
+            merge_flat_patches(&v, t.clone(), &FxHashSet::default()).len(),
+            1
+        );
         // A fin on edge (1, 5), from the outer to the inner boundary: the ring is still one
         // patch, but merging it would drop that edge. It stays as triangles.
         v.push(DVec3::new(1.0, 0.5, 1.0));
         t.push(([1, 5, 16], 7));
-        let f = merge_flat_patches(&v, t);
+        let f = merge_flat_patches(&v, t, &FxHashSet::default());
         assert_eq!(f.len(), 17);
         assert!(f.iter().all(|f| f.polygons[0].len() == 3));
     }

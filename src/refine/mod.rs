@@ -20,6 +20,7 @@ pub mod report;
 mod spacing;
 
 pub(crate) use mark::unknown_region;
+pub use mark::Unseeded;
 pub use marker_size::{MarkerCapped, MarkerCaps, MARKER_GRADING};
 pub use quality::SPACING_BATCH;
 pub use spacing::AutoSpacing;
@@ -31,7 +32,6 @@ use crate::run::params::Params;
 use crate::run::progress::Progress;
 use crate::run::report::{Refusals, Report};
 use crate::run::spacing::Spacing;
-use mark::Unseeded;
 use recover::Settled;
 use rustc_hash::FxHashSet;
 
@@ -54,36 +54,87 @@ pub fn mesh(
     spacing: Option<&dyn Spacing>,
     progress: Option<Progress>,
 ) -> Result<(TetMesh, Report), MeshError> {
-    mesh_domain(
-        input,
-        params,
-        spacing,
-        progress,
-        SmallAngles::Input,
-        Unseeded::Domain,
-        &[],
-    )
+    mesh_domain(input, params, spacing, progress, Choices::plc())
 }
 
 /// [`mesh`] with `frozen` facets (indices into `input.facets`) never split nor flipped: no
 /// point goes where its cavity would remove one of their triangles, and bad tets that would
 /// need one are left (`Refusals::frozen_interface`). For a partition's interfaces
 /// (`crate::partition`): each side meshed alone keeps the same triangles there.
+/// `unseeded`: what a component without a region seed becomes (`Unseeded::Hole` for a set of
+/// tets, whose pieces are all seeded).
 pub fn mesh_frozen(
     input: &PlcInput,
     params: &Params,
     spacing: Option<&dyn Spacing>,
     frozen: &[u32],
+    unseeded: Unseeded,
 ) -> Result<(TetMesh, Report), MeshError> {
-    mesh_domain(
-        input,
-        params,
-        spacing,
-        None,
-        SmallAngles::Input,
-        Unseeded::Domain,
+    let choices = Choices {
+        unseeded,
         frozen,
-    )
+        ..Choices::plc()
+    };
+    mesh_domain(input, params, spacing, None, choices)
+}
+
+/// [`mesh_frozen`], also giving per vertex of the mesh the input segment it was inserted on
+/// (its end vertices), if any.
+pub fn mesh_frozen_tracing_segments(
+    input: &PlcInput,
+    params: &Params,
+    spacing: Option<&dyn Spacing>,
+    frozen: &[u32],
+    unseeded: Unseeded,
+) -> Result<(TetMesh, Report, SegmentEnds), MeshError> {
+    let mut ends = vec![];
+    let choices = Choices {
+        unseeded,
+        frozen,
+        segment_ends: Some(&mut ends),
+        ..Choices::plc()
+    };
+    let (mesh, report) = mesh_domain(input, params, spacing, None, choices)?;
+    Ok((mesh, report, ends))
+}
+
+/// The automatic spacing of `input` ([`mesh`]'s with no spacing given): the Lipschitz
+/// extension of its recovered boundary's edge lengths.
+pub fn auto_spacing(input: &PlcInput, params: &Params) -> Result<AutoSpacing, MeshError> {
+    params.check().map_err(MeshError::InvalidInput)?;
+    let plc = crate::plc::validate(input).map_err(|e| MeshError::InvalidInput(e.to_string()))?;
+    let mut dom = domain::Domain::new(input, &plc)?;
+    dom.set_input_angles(&plc, params.small_angle_reach);
+    let mut budget = recover::MAX_RECOVERY_SPLITS.min(params.max_vertices.saturating_mul(4));
+    if dom.recover_boundary(&mut budget)? == Settled::BudgetSpent {
+        return Err(recovery_budget_spent(params));
+    }
+    Ok(AutoSpacing::from_boundary(&dom))
+}
+
+/// Per vertex, the input segment (its end vertices) it was inserted on, if any.
+pub type SegmentEnds = Vec<Option<[u32; 2]>>;
+
+/// How [`mesh_domain`] treats its input.
+struct Choices<'a> {
+    small_angles: SmallAngles,
+    unseeded: Unseeded,
+    /// Facets never split nor flipped (`Domain::frozen`).
+    frozen: &'a [u32],
+    /// Where to put each vertex's input segment.
+    segment_ends: Option<&'a mut SegmentEnds>,
+}
+
+impl Choices<'_> {
+    /// A PLC's: its small angles, unseeded cells in the domain, nothing frozen.
+    fn plc() -> Self {
+        Choices {
+            small_angles: SmallAngles::Input,
+            unseeded: Unseeded::Domain,
+            frozen: &[],
+            segment_ends: None,
+        }
+    }
 }
 
 /// Which input angles refinement treats as small.
@@ -104,10 +155,14 @@ fn mesh_domain(
     params: &Params,
     spacing: Option<&dyn Spacing>,
     progress: Option<Progress>,
-    small_angles: SmallAngles,
-    unseeded: Unseeded,
-    frozen: &[u32],
+    choices: Choices,
 ) -> Result<(TetMesh, Report), MeshError> {
+    let Choices {
+        small_angles,
+        unseeded,
+        frozen,
+        segment_ends,
+    } = choices;
     let start = std::time::Instant::now();
     params.check().map_err(MeshError::InvalidInput)?;
     let plc = crate::plc::validate(input).map_err(|e| MeshError::InvalidInput(e.to_string()))?;
@@ -176,6 +231,14 @@ fn mesh_domain(
     let seconds_refinement = start.elapsed().as_secs_f64() - seconds_recovery;
     dom.check_frozen_present()?;
     let mesh = dom.to_mesh(&regions);
+    if let Some(ends) = segment_ends {
+        *ends = (dom.kind.iter())
+            .map(|k| match *k {
+                domain::VertexKind::Segment(s) => Some(dom.segments[s as usize].ends),
+                _ => None,
+            })
+            .collect();
+    }
     // The triangulation is freed before the report measures the mesh: the two together were
     // the run's peak memory.
     let acute: Vec<bool> = (0..mesh.vertices.len() as u32)

@@ -1,0 +1,204 @@
+//! The band: the coarse tets around the interfaces between parts, meshed once with each tet's
+//! region paired with its part, so that the interfaces are internal facets refined from both
+//! sides. Its interface triangles become every part's frozen facets and its inner vertices
+//! the parts' seeds (the tets next to an interface start as the band's).
+
+use super::coarse::{sorted_faces, Coarse};
+use super::INTERFACE_MARKER;
+use crate::mesh::TetMesh;
+use crate::run::error::MeshError;
+use crate::run::params::Params;
+use crate::run::spacing::Spacing;
+use rustc_hash::{FxHashMap, FxHashSet};
+
+pub(super) struct Band {
+    /// Coarse tets in the band.
+    pub n_coarse_tets: usize,
+    /// The refined band (region attributes are codes of (region, part) pairs).
+    pub mesh: TetMesh,
+    /// Per part: the band's triangles between it and another part (band vertex ids).
+    pub interface: Vec<Vec<[u32; 3]>>,
+    /// Per part: band vertices inside it, on no facet of the band.
+    pub seeds: Vec<Vec<u32>>,
+    /// The band's vertices on each coarse edge it split (coarse vertex ids, smaller first),
+    /// from the smaller end to the larger.
+    pub chains: FxHashMap<(u32, u32), Vec<u32>>,
+}
+
+impl Band {
+    pub fn new(coarse: &Coarse, params: &Params, spacing: &dyn Spacing) -> Result<Band, MeshError> {
+        let m = &coarse.mesh;
+        let mut face_tets: FxHashMap<[u32; 3], Vec<u32>> = FxHashMap::default();
+        for t in 0..m.tets.len() {
+            for f in coarse.faces(t) {
+                face_tets.entry(f).or_default().push(t as u32);
+            }
+        }
+        let mut on_interface = vec![false; m.vertices.len()];
+        let mut interface_faces = FxHashSet::default();
+        for (f, ts) in &face_tets {
+            if ts.len() == 2 && coarse.part_of[ts[0] as usize] != coarse.part_of[ts[1] as usize] {
+                f.iter().for_each(|&v| on_interface[v as usize] = true);
+                interface_faces.insert(*f);
+            }
+        }
+        let in_band: Vec<u32> = (0..m.tets.len() as u32)
+            .filter(|&t| m.tets[t as usize].iter().any(|&v| on_interface[v as usize]))
+            .collect();
+        // (region, part) -> code, in first-seen order (deterministic).
+        let mut codes: FxHashMap<(i32, u32), i32> = FxHashMap::default();
+        let mut part_of_code = vec![];
+        let mut sub = TetMesh::default();
+        let mut local = vec![u32::MAX; m.vertices.len()];
+        for &t in &in_band {
+            let tv = m.tets[t as usize].map(|v| {
+                if local[v as usize] == u32::MAX {
+                    local[v as usize] = sub.vertices.len() as u32;
+                    sub.vertices.push(m.vertices[v as usize]);
+                }
+                local[v as usize]
+            });
+            sub.tets.push(tv);
+            let part = coarse.part_of[t as usize];
+            let key = (m.tet_regions[t as usize], part);
+            let next = codes.len() as i32 + 1;
+            let code = *codes.entry(key).or_insert_with(|| {
+                part_of_code.push(part);
+                next
+            });
+            sub.tet_regions.push(code);
+        }
+        let band_faces: FxHashSet<[u32; 3]> = in_band
+            .iter()
+            .flat_map(|&t| coarse.faces(t as usize))
+            .collect();
+        // The interfaces first, with a marker of their own (listed first, they keep it where
+        // a region interface lies on them): their refined triangles are the ones with it.
+        let mut interfaces: Vec<&[u32; 3]> = interface_faces.iter().collect();
+        interfaces.sort_unstable();
+        for f in interfaces {
+            sub.boundary.push(f.map(|v| local[v as usize]));
+            sub.boundary_markers.push(INTERFACE_MARKER);
+        }
+        for (b, &marker) in m.boundary.iter().zip(&m.boundary_markers) {
+            let mut key = *b;
+            key.sort_unstable();
+            if band_faces.contains(&key) {
+                sub.boundary.push(b.map(|v| local[v as usize]));
+                sub.boundary_markers.push(marker);
+            }
+        }
+        let input = crate::refine::existing::plc_of_mesh_except(&sub, &|_| false)?;
+        let band_params = Params {
+            improve: false,
+            order: 1,
+            ..params.clone()
+        };
+        let (mesh, _, segment_ends) = crate::refine::mesh_frozen_tracing_segments(
+            &input,
+            &band_params,
+            Some(spacing),
+            &[],
+            crate::refine::Unseeded::Hole,
+        )
+        .map_err(|e| MeshError::Internal(format!("meshing the partition's band: {e}")))?;
+        let mut coarse_of = vec![u32::MAX; sub.vertices.len()];
+        for (v, &l) in local.iter().enumerate() {
+            if l != u32::MAX {
+                coarse_of[l as usize] = v as u32;
+            }
+        }
+        let chains = chains(&mesh, &segment_ends, &coarse_of);
+        let part_of_tet: Vec<u32> = (mesh.tet_regions.iter())
+            .map(|&c| part_of_code[(c - 1) as usize])
+            .collect();
+        let (interface, seeds) = split_by_part(&mesh, &part_of_tet, coarse.parts);
+        Ok(Band {
+            n_coarse_tets: in_band.len(),
+            mesh,
+            interface,
+            seeds,
+            chains,
+        })
+    }
+}
+
+/// Per part, the band's faces between it and another part, and its vertices on no facet
+/// whose tets are all in it.
+fn split_by_part(
+    mesh: &TetMesh,
+    part_of_tet: &[u32],
+    parts: usize,
+) -> (Vec<Vec<[u32; 3]>>, Vec<Vec<u32>>) {
+    let mut face_tets: FxHashMap<[u32; 3], Vec<u32>> = FxHashMap::default();
+    for (t, &tv) in mesh.tets.iter().enumerate() {
+        for f in sorted_faces(tv) {
+            face_tets.entry(f).or_default().push(t as u32);
+        }
+    }
+    // The interface's refined triangles, each given to the parts of the tets on its sides.
+    let mut interface = vec![vec![]; parts];
+    for (b, &marker) in mesh.boundary.iter().zip(&mesh.boundary_markers) {
+        if marker != INTERFACE_MARKER {
+            continue;
+        }
+        let mut f = *b;
+        f.sort_unstable();
+        for &t in face_tets.get(&f).into_iter().flatten() {
+            let p = part_of_tet[t as usize] as usize;
+            if interface[p].last() != Some(&f) {
+                interface[p].push(f);
+            }
+        }
+    }
+    let mut on_facet = vec![false; mesh.vertices.len()];
+    for b in &mesh.boundary {
+        b.iter().for_each(|&v| on_facet[v as usize] = true);
+    }
+    // u32::MAX: no tet yet; u32::MAX - 1: tets in several parts.
+    let mut part_of_vertex = vec![u32::MAX; mesh.vertices.len()];
+    for (tv, &p) in mesh.tets.iter().zip(part_of_tet) {
+        for &v in tv {
+            let s = &mut part_of_vertex[v as usize];
+            *s = if *s == u32::MAX || *s == p {
+                p
+            } else {
+                u32::MAX - 1
+            };
+        }
+    }
+    let mut seeds = vec![vec![]; parts];
+    for (v, &p) in part_of_vertex.iter().enumerate() {
+        if (p as usize) < parts && !on_facet[v] {
+            seeds[p as usize].push(v as u32);
+        }
+    }
+    (interface, seeds)
+}
+
+/// The band's vertices on each input segment of its PLC (a coarse edge), in order along it:
+/// keyed by the coarse ends (smaller first), ordered from the smaller end.
+fn chains(
+    mesh: &TetMesh,
+    segment_ends: &[Option<[u32; 2]>],
+    coarse_of: &[u32],
+) -> FxHashMap<(u32, u32), Vec<u32>> {
+    let mut along: FxHashMap<(u32, u32), Vec<(f64, u32)>> = FxHashMap::default();
+    for (v, ends) in segment_ends.iter().enumerate() {
+        let Some([a, b]) = *ends else {
+            continue;
+        };
+        let (ca, cb) = (coarse_of[a as usize], coarse_of[b as usize]);
+        let (lo, hi, from) = if ca < cb { (ca, cb, a) } else { (cb, ca, b) };
+        let origin = mesh.vertices[from as usize];
+        let t = mesh.vertices[v].distance_squared(origin);
+        along.entry((lo, hi)).or_default().push((t, v as u32));
+    }
+    along
+        .into_iter()
+        .map(|(k, mut pts)| {
+            pts.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+            (k, pts.into_iter().map(|(_, v)| v).collect())
+        })
+        .collect()
+}

@@ -1,0 +1,111 @@
+//! The coarse mesh a partition is cut from, and the cut: runs of equal estimated final size
+//! along the Hilbert order of the tets' centroids.
+
+use crate::delaunay::hilbert::hilbert_sort;
+use crate::mesh::TetMesh;
+use crate::plc::PlcInput;
+use crate::run::error::MeshError;
+use crate::run::params::Params;
+use crate::run::spacing::Spacing;
+use glam::DVec3;
+
+/// The coarse mesh's spacing, as a multiple of the final one: about 64 final tets a coarse
+/// one, so that the coarse mesh is cheap and its tets still follow the grading.
+const COARSE_FACTOR: f64 = 4.0;
+
+/// The spacing times a factor.
+struct Scaled<'a>(&'a dyn Spacing, f64);
+
+impl Spacing for Scaled<'_> {
+    fn at(&self, p: DVec3) -> f64 {
+        self.0.at(p) * self.1
+    }
+
+    fn at_many(&self, points: &[DVec3], out: &mut [f64]) {
+        self.0.at_many(points, out);
+        out.iter_mut().for_each(|f| *f *= self.1);
+    }
+}
+
+pub(super) struct Coarse {
+    pub parts: usize,
+    /// The coarse mesh (refined and improved, its boundary on the input's facets).
+    pub mesh: TetMesh,
+    /// The part of each coarse tet.
+    pub part_of: Vec<u32>,
+}
+
+impl Coarse {
+    pub fn new(
+        input: &PlcInput,
+        params: &Params,
+        spacing: &dyn Spacing,
+        parts: usize,
+    ) -> Result<Coarse, MeshError> {
+        let coarse_params = Params {
+            order: 1,
+            ..params.clone()
+        };
+        let scaled = Scaled(spacing, COARSE_FACTOR);
+        let (mesh, mut report) = crate::refine::mesh(input, &coarse_params, Some(&scaled), None)?;
+        let mesh = crate::pipeline::improve(mesh, &mut report, Some(input), &coarse_params)?;
+        if mesh.tets.len() < parts {
+            return Err(MeshError::InvalidInput(format!(
+                "{parts} parts from a coarse mesh of {} tets: too many parts for this size",
+                mesh.tets.len()
+            )));
+        }
+        let part_of = cut(&mesh, spacing, parts);
+        Ok(Coarse {
+            parts,
+            mesh,
+            part_of,
+        })
+    }
+
+    /// The sorted faces of tet `t`.
+    pub fn faces(&self, t: usize) -> [[u32; 3]; 4] {
+        sorted_faces(self.mesh.tets[t])
+    }
+}
+
+/// The four faces of a tet, each as its sorted vertex triple.
+pub(super) fn sorted_faces(t: [u32; 4]) -> [[u32; 3]; 4] {
+    [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]].map(|f| {
+        let mut k = f.map(|i| t[i]);
+        k.sort_unstable();
+        k
+    })
+}
+
+/// Each tet's part: the tets in Hilbert order of their centroids, cut into `parts` runs of
+/// equal estimated final tet count (volume / f(centroid)^3).
+fn cut(mesh: &TetMesh, spacing: &dyn Spacing, parts: usize) -> Vec<u32> {
+    let corners = |t: &[u32; 4]| t.map(|v| mesh.vertices[v as usize]);
+    let centroids: Vec<DVec3> = (mesh.tets.iter())
+        .map(|t| corners(t).iter().sum::<DVec3>() / 4.0)
+        .collect();
+    let mut f = vec![0.0; centroids.len()];
+    spacing.at_many(&centroids, &mut f);
+    let weight: Vec<f64> = (mesh.tets.iter().zip(&f))
+        .map(|(t, &f)| {
+            let [a, b, c, d] = corners(t);
+            ((b - a).cross(c - a).dot(d - a).abs() / 6.0) / (f * f * f).max(f64::MIN_POSITIVE)
+        })
+        .collect();
+    let mut order: Vec<u32> = (0..mesh.tets.len() as u32).collect();
+    hilbert_sort(&centroids, &mut order);
+    let total: f64 = weight.iter().sum();
+    let mut part_of = vec![0u32; mesh.tets.len()];
+    let mut done = 0.0;
+    for (k, &t) in order.iter().enumerate() {
+        // The part whose share the middle of this tet's weight falls in, but never fewer
+        // tets left than parts to fill.
+        let share = ((done + 0.5 * weight[t as usize]) / total * parts as f64) as usize;
+        let left = order.len() - k;
+        let part = share.min(parts - 1).max(parts.saturating_sub(left));
+        part_of[t as usize] = part as u32;
+        done += weight[t as usize];
+    }
+    part_of
+}

@@ -1,0 +1,156 @@
+//! One part's PLC: the boundary of its coarse tets (the domain's facets and region
+//! interfaces, flat patches merged), closed where it meets other parts by the band's
+//! interface triangles, each a frozen facet. The domain's facets along the interface's rim
+//! get the band's rim vertices in their polygon edges (no T-junctions), and the band's inner
+//! vertices on the part's side come in as isolated vertices.
+
+use super::band::Band;
+use super::coarse::Coarse;
+use super::INTERFACE_MARKER;
+use crate::mesh::TetMesh;
+use crate::plc::{Facet, PlcInput};
+use crate::run::error::MeshError;
+use glam::DVec3;
+use rustc_hash::{FxHashMap, FxHashSet};
+
+/// The exact coordinates of a point, as a hash key.
+fn key(p: DVec3) -> [u64; 3] {
+    p.to_array().map(f64::to_bits)
+}
+
+/// Part `part`'s PLC and its frozen facets (indices into the PLC's facets).
+pub(super) fn build(
+    coarse: &Coarse,
+    band: &Band,
+    part: usize,
+) -> Result<(PlcInput, Vec<u32>), MeshError> {
+    let m = &coarse.mesh;
+    let mut face_parts: FxHashMap<[u32; 3], Vec<u32>> = FxHashMap::default();
+    for t in 0..m.tets.len() {
+        for f in coarse.faces(t) {
+            face_parts.entry(f).or_default().push(coarse.part_of[t]);
+        }
+    }
+    let is_interface = |f: &[u32; 3]| {
+        face_parts
+            .get(f)
+            .is_some_and(|ps| ps.len() == 2 && ps[0] != ps[1])
+    };
+    // The part's coarse tets, renumbered.
+    let mut sub = TetMesh::default();
+    let mut local = vec![u32::MAX; m.vertices.len()];
+    for (t, &tv) in m.tets.iter().enumerate() {
+        if coarse.part_of[t] as usize != part {
+            continue;
+        }
+        sub.tets.push(tv.map(|v| {
+            if local[v as usize] == u32::MAX {
+                local[v as usize] = sub.vertices.len() as u32;
+                sub.vertices.push(m.vertices[v as usize]);
+            }
+            local[v as usize]
+        }));
+        sub.tet_regions.push(m.tet_regions[t]);
+    }
+    if sub.tets.is_empty() {
+        return Err(MeshError::InvalidInput(format!(
+            "part {part} got no coarse tets: too many parts for this size"
+        )));
+    }
+    let part_faces: FxHashSet<[u32; 3]> = (0..m.tets.len())
+        .filter(|&t| coarse.part_of[t] as usize == part)
+        .flat_map(|t| coarse.faces(t))
+        .collect();
+    for (b, &marker) in m.boundary.iter().zip(&m.boundary_markers) {
+        let mut k = *b;
+        k.sort_unstable();
+        // A region interface on a part interface is closed by the band's triangles.
+        if part_faces.contains(&k) && !is_interface(&k) {
+            sub.boundary.push(b.map(|v| local[v as usize]));
+            sub.boundary_markers.push(marker);
+        }
+    }
+    let global: Vec<u32> = {
+        let mut g = vec![0; sub.vertices.len()];
+        for (v, &l) in local.iter().enumerate() {
+            if l != u32::MAX {
+                g[l as usize] = v as u32;
+            }
+        }
+        g
+    };
+    let open = |f: &[u32; 3]| {
+        let mut k = f.map(|v| global[v as usize]);
+        k.sort_unstable();
+        is_interface(&k)
+    };
+    let mut input = crate::refine::existing::plc_of_mesh_except(&sub, &open)?;
+
+    // The band's vertices: the coarse ones are the part's already (same coordinates).
+    let mut index: FxHashMap<[u64; 3], u32> = (input.vertices.iter().enumerate())
+        .map(|(i, &p)| (key(p), i as u32))
+        .collect();
+    let bv = &band.mesh.vertices;
+    let mut vertices = std::mem::take(&mut input.vertices);
+    let mut id_of = |v: u32| -> u32 {
+        let p = bv[v as usize];
+        *index.entry(key(p)).or_insert_with(|| {
+            vertices.push(p);
+            vertices.len() as u32 - 1
+        })
+    };
+    let tris: Vec<[u32; 3]> = band.interface[part]
+        .iter()
+        .map(|t| t.map(&mut id_of))
+        .collect();
+    for &s in &band.seeds[part] {
+        id_of(s);
+    }
+    insert_chains(&mut input.facets, &global, &band.chains, &mut id_of);
+    input.vertices = vertices;
+    let first_frozen = input.facets.len() as u32;
+    input.facets.extend(tris.iter().map(|t| Facet {
+        polygons: vec![t.to_vec()],
+        marker: INTERFACE_MARKER,
+        ..Default::default()
+    }));
+    let frozen = (first_frozen..input.facets.len() as u32).collect();
+    Ok((input, frozen))
+}
+
+/// Puts the band's vertices on coarse edges (`Band::chains`) into the polygon edges of
+/// `facets` along those edges (`global`: a PLC vertex's coarse id, for the first ones), so
+/// that the interface's triangles meet them at vertices.
+fn insert_chains(
+    facets: &mut [Facet],
+    global: &[u32],
+    chains: &FxHashMap<(u32, u32), Vec<u32>>,
+    id_of: &mut dyn FnMut(u32) -> u32,
+) {
+    for f in facets.iter_mut() {
+        for polygon in f.polygons.iter_mut().chain(f.hole_polygons.iter_mut()) {
+            let n = polygon.len();
+            if n < 3 {
+                continue; // a lone point, or a segment (no coarse mesh has those)
+            }
+            let mut out = Vec::with_capacity(n);
+            for k in 0..n {
+                let (a, b) = (polygon[k], polygon[(k + 1) % n]);
+                out.push(a);
+                let (Some(&ga), Some(&gb)) = (global.get(a as usize), global.get(b as usize))
+                else {
+                    continue;
+                };
+                if let Some(chain) = chains.get(&(ga.min(gb), ga.max(gb))) {
+                    let ids = chain.iter().map(|&v| id_of(v));
+                    if ga < gb {
+                        out.extend(ids);
+                    } else {
+                        out.extend(ids.collect::<Vec<_>>().into_iter().rev());
+                    }
+                }
+            }
+            *polygon = out;
+        }
+    }
+}

@@ -1,0 +1,117 @@
+//! Partitioned meshing (`partition`): every part meshed alone from the same plan; glued by
+//! coordinates the parts make one conforming mesh of the domain, with its volume and regions.
+
+mod common;
+
+use slivermesh::mesh::TetMesh;
+use slivermesh::run::params::Params;
+use slivermesh::run::spacing::ConstantSpacing;
+use std::collections::HashMap;
+
+/// The parts glued by vertex coordinates (bit for bit), boundary triangles once each.
+fn glue(parts: &[TetMesh]) -> TetMesh {
+    let mut out = TetMesh::default();
+    let mut index: HashMap<[u64; 3], u32> = HashMap::new();
+    let mut seen = std::collections::HashSet::new();
+    for m in parts {
+        let ids: Vec<u32> = m
+            .vertices
+            .iter()
+            .map(|p| {
+                *index
+                    .entry(p.to_array().map(f64::to_bits))
+                    .or_insert_with(|| {
+                        out.vertices.push(*p);
+                        out.vertices.len() as u32 - 1
+                    })
+            })
+            .collect();
+        out.tets
+            .extend(m.tets.iter().map(|t| t.map(|v| ids[v as usize])));
+        out.tet_regions.extend(&m.tet_regions);
+        for (b, &marker) in m.boundary.iter().zip(&m.boundary_markers) {
+            let b = b.map(|v| ids[v as usize]);
+            let mut k = b;
+            k.sort_unstable();
+            if seen.insert(k) {
+                out.boundary.push(b);
+                out.boundary_markers.push(marker);
+            }
+        }
+    }
+    out
+}
+
+/// Every face in at most two tets; the faces of one tet are boundary triangles.
+fn check_conforming(m: &TetMesh) {
+    let mut faces: HashMap<[u32; 3], usize> = HashMap::new();
+    for t in &m.tets {
+        for skip in 0..4 {
+            let mut f: Vec<u32> = (0..4).filter(|&i| i != skip).map(|i| t[i]).collect();
+            f.sort_unstable();
+            *faces.entry([f[0], f[1], f[2]]).or_default() += 1;
+        }
+    }
+    let boundary: std::collections::HashSet<[u32; 3]> = m
+        .boundary
+        .iter()
+        .map(|b| {
+            let mut k = *b;
+            k.sort_unstable();
+            k
+        })
+        .collect();
+    for (f, &k) in &faces {
+        assert!(k <= 2, "face {f:?} in {k} tets");
+        if k == 1 {
+            let p = f.map(|v| m.vertices[v as usize]);
+            assert!(
+                boundary.contains(f),
+                "open face {p:?} is not a boundary triangle"
+            );
+        }
+    }
+}
+
+fn mesh_in_parts(model: &str, size: f64, parts: usize) -> (TetMesh, f64) {
+    let input = common::read_model(model);
+    let params = Params::default();
+    let spacing = ConstantSpacing(size);
+    let plan = slivermesh::partition::plan(&input, &params, Some(&spacing), parts)
+        .unwrap_or_else(|e| panic!("{model}: {e}"));
+    let (coarse, band_tets, band_vertices) = plan.sizes();
+    let mut meshes = vec![];
+    let mut worst = f64::MAX;
+    for part in 0..parts {
+        let (mesh, report) = slivermesh::partition::mesh_part(&plan, part)
+            .unwrap_or_else(|e| panic!("{model} part {part}: {e}"));
+        let q = slivermesh::quality::measure(&mesh).unwrap();
+        println!(
+            "{model} {parts} parts: part {part}: {} tets, min dihedral {:.2}, refusals {}",
+            mesh.tets.len(),
+            q.min_dihedral_deg,
+            report.refusals.summary()
+        );
+        worst = worst.min(q.min_dihedral_deg);
+        meshes.push(mesh);
+    }
+    println!(
+        "{model}: coarse {coarse} tets, band {band_tets} coarse tets, {band_vertices} vertices"
+    );
+    (glue(&meshes), worst)
+}
+
+#[test]
+fn cube_in_two_and_three_parts_is_conforming() {
+    for parts in [2, 3] {
+        let (whole, worst) = mesh_in_parts("poly/cube.poly", 0.08, parts);
+        common::check_orientation(&whole);
+        check_conforming(&whole);
+        let volume = common::total_volume(&whole);
+        assert!(common::rel_close(volume, 1.0, 1e-9), "volume {volume}");
+        println!(
+            "cube {parts} parts: {} tets, min dihedral {worst:.2}",
+            whole.tets.len()
+        );
+    }
+}
