@@ -8,7 +8,7 @@
 
 use super::tables::FACE;
 use super::{has_infinite, Delaunay, DelaunayError, Inserted, Tet, DEAD, INFINITE};
-use crate::geom::{insphere, insphere_tie, orient3d, InsphereFan};
+use crate::geom::{insphere, insphere_tie, insphere_tie_by_coordinates, orient3d, InsphereFan};
 use glam::DVec3;
 
 /// Reusable buffers for cavity searches.
@@ -419,6 +419,9 @@ impl Delaunay {
         let s = insphere(q[0], q[1], q[2], q[3], p);
         if s != 0.0 {
             return s > 0.0;
+        }
+        if self.ties_by_coordinates {
+            return insphere_tie_by_coordinates(q, p);
         }
         insphere_tie(q, v.map(|i| self.rank[i as usize]), p, rank)
     }

@@ -103,6 +103,10 @@ pub struct Delaunay {
     /// Symbolic-perturbation rank of each vertex: its insertion index (bulk) or its id (later
     /// insertions). Fixed for the vertex's lifetime so every tie is decided the same way.
     rank: Vec<u32>,
+    /// Ties broken by the points' coordinates instead of `rank`
+    /// (`geom::insphere_tie_by_coordinates`): set for triangulations that must break their
+    /// ties as another triangulation of an overlapping point set does (a partition's parts).
+    ties_by_coordinates: bool,
     tets: Vec<Tet>,
     /// Scratch flag per tet for cavity searches; zero between calls.
     mark: Vec<u8>,
@@ -130,6 +134,15 @@ impl Delaunay {
     /// Triangulates `points`; vertex id i is `points[i]` (duplicates are skipped, ids unused).
     /// Inserts in BRIO / Hilbert order.
     pub fn from_points(points: &[DVec3]) -> Result<(Self, InsertStats), DelaunayError> {
+        Self::from_points_with(points, false)
+    }
+
+    /// [`Self::from_points`], its ties broken by the points' coordinates when
+    /// `ties_by_coordinates` (see the field), for its whole life.
+    pub fn from_points_with(
+        points: &[DVec3],
+        ties_by_coordinates: bool,
+    ) -> Result<(Self, InsertStats), DelaunayError> {
         for (index, &p) in points.iter().enumerate() {
             geom::check_coordinate(p).map_err(|reason| DelaunayError::BadCoordinate {
                 index,
@@ -145,6 +158,7 @@ impl Delaunay {
             points: order.iter().map(|&i| points[i as usize]).collect(),
             vertex_tet: vec![NO_TET; points.len()],
             rank: (0..points.len() as u32).collect(),
+            ties_by_coordinates,
             rng: 0x9e37_79b9,
             ..Default::default()
         };

@@ -86,12 +86,14 @@ impl Delaunay {
         if t_finite && apex != INFINITE {
             let q = self.tet_points(t);
             let ranks = v.map(|x| self.rank[x as usize]);
-            if insphere_sos(
-                q,
-                ranks,
-                self.points[apex as usize],
-                self.rank[apex as usize],
-            ) {
+            let e = self.points[apex as usize];
+            let inside = if self.ties_by_coordinates {
+                let s = crate::geom::insphere(q[0], q[1], q[2], q[3], e);
+                s > 0.0 || (s == 0.0 && crate::geom::insphere_tie_by_coordinates(q, e))
+            } else {
+                insphere_sos(q, ranks, e, self.rank[apex as usize])
+            };
+            if inside {
                 return Err(format!(
                     "face {i} of tet {t} {v:?} is not locally Delaunay: vertex {apex} is inside"
                 ));

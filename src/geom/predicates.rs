@@ -612,6 +612,32 @@ pub fn insphere_tie(p: [DVec3; 4], ranks: [u32; 4], e: DVec3, rank_e: u32) -> bo
     unreachable!("insphere_tie: the first four points must form a non-degenerate tet")
 }
 
+/// [`insphere_tie`] with the points ranked by their coordinates (lexicographically, x first;
+/// the larger ranks higher) instead of by index: the tie-break then depends only on the
+/// points, so every triangulation holding a set of points breaks its ties alike, whatever
+/// the insertion order (CGAL's perturbation orders points the same way).
+#[cold]
+pub fn insphere_tie_by_coordinates(p: [DVec3; 4], e: DVec3) -> bool {
+    let point = |i: usize| if i == 4 { e } else { p[i] };
+    let mut order = [0usize, 1, 2, 3, 4];
+    order.sort_unstable_by(|&i, &j| {
+        let (a, b) = (point(i).to_array(), point(j).to_array());
+        b.partial_cmp(&a).unwrap_or(Ordering::Equal)
+    });
+    for &i in &order {
+        if i == 4 {
+            return false;
+        }
+        let mut q = p;
+        q[i] = e;
+        let o = orient3d(q[0], q[1], q[2], q[3]);
+        if o != 0.0 {
+            return o > 0.0;
+        }
+    }
+    unreachable!("insphere_tie_by_coordinates: the first four points must form a tet")
+}
+
 /// Why a coordinate was rejected.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum CoordError {

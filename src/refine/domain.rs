@@ -110,7 +110,18 @@ impl Domain {
     /// Triangulates the input vertices and sets up the segments (the checked PLC's, in its
     /// numbering) and the facet triangulations.
     pub fn new(input: &PlcInput, plc: &Plc) -> Result<Domain, MeshError> {
-        let (mut dt, stats) = Delaunay::from_points(&input.vertices)
+        Self::new_with_ties(input, plc, false)
+    }
+
+    /// [`Domain::new`], the triangulation breaking its ties by the points' coordinates when
+    /// `ties_by_coordinates` (`Delaunay::from_points_with`): a partition's parts and band,
+    /// which must have their shared triangles alike.
+    pub fn new_with_ties(
+        input: &PlcInput,
+        plc: &Plc,
+        ties_by_coordinates: bool,
+    ) -> Result<Domain, MeshError> {
+        let (mut dt, stats) = Delaunay::from_points_with(&input.vertices, ties_by_coordinates)
             .map_err(|e| MeshError::InvalidInput(e.to_string()))?;
         if stats.duplicates > 0 {
             return Err(MeshError::InvalidInput(format!(

@@ -60,8 +60,9 @@ pub fn mesh(
 /// [`mesh`] with `frozen` facets (indices into `input.facets`) never split nor flipped: no
 /// point goes where its cavity would remove one of their triangles, and bad tets that would
 /// need one are left (`Refusals::frozen_interface`). For a partition's interfaces
-/// (`crate::partition`): each side meshed alone keeps the same triangles there.
-/// `unseeded`: what a component without a region seed becomes (`Unseeded::Hole` for a set of
+/// (`crate::partition`): each side meshed alone keeps the same triangles there. Delaunay ties
+/// are broken by the points' coordinates, so that every mesh holding some of the same points
+/// breaks them alike. `unseeded`: what a component without a region seed becomes (`Unseeded::Hole` for a set of
 /// tets, whose pieces are all seeded).
 pub fn mesh_frozen(
     input: &PlcInput,
@@ -73,6 +74,7 @@ pub fn mesh_frozen(
     let choices = Choices {
         unseeded,
         frozen,
+        ties_by_coordinates: true,
         ..Choices::plc()
     };
     mesh_domain(input, params, spacing, None, choices)
@@ -92,6 +94,7 @@ pub fn mesh_frozen_tracing_segments(
         unseeded,
         frozen,
         segment_ends: Some(&mut ends),
+        ties_by_coordinates: true,
         ..Choices::plc()
     };
     let (mesh, report) = mesh_domain(input, params, spacing, None, choices)?;
@@ -123,6 +126,8 @@ struct Choices<'a> {
     frozen: &'a [u32],
     /// Where to put each vertex's input segment.
     segment_ends: Option<&'a mut SegmentEnds>,
+    /// Delaunay ties broken by coordinates (`Domain::new_with_ties`).
+    ties_by_coordinates: bool,
 }
 
 impl Choices<'_> {
@@ -133,6 +138,7 @@ impl Choices<'_> {
             unseeded: Unseeded::Domain,
             frozen: &[],
             segment_ends: None,
+            ties_by_coordinates: false,
         }
     }
 }
@@ -162,6 +168,7 @@ fn mesh_domain(
         unseeded,
         frozen,
         segment_ends,
+        ties_by_coordinates,
     } = choices;
     let start = std::time::Instant::now();
     params.check().map_err(MeshError::InvalidInput)?;
@@ -172,7 +179,7 @@ fn mesh_domain(
         let surface = crate::surface::InputSurface::from_plc(&plc);
         MarkerCaps::new(&surface, &params.marker_sizes)?
     };
-    let mut dom = domain::Domain::new(input, &plc)?;
+    let mut dom = domain::Domain::new_with_ties(input, &plc, ties_by_coordinates)?;
     if let Some(&f) = frozen.iter().find(|&&f| f as usize >= input.facets.len()) {
         return Err(MeshError::InvalidInput(format!(
             "frozen facet {f}: the input has {} facets",

@@ -95,12 +95,10 @@ impl Domain {
                 if !spend(budget) {
                     return Ok(Settled::BudgetSpent);
                 }
-                let p = self.segment_split_point(a, b);
-                let hint = self.dt.vertex_tet(a);
-                if self.is_frozen_subsegment((a, b)) || !self.may_insert_at(p, hint) {
+                let Some(p) = self.split_point_clear_of_frozen(a, b) else {
                     frozen_missing(status, &format!("subsegment ({a}, {b})"))?;
                     continue;
-                }
+                };
                 self.split_subsegment(a, b, p, None)?;
                 continue;
             }
@@ -242,12 +240,10 @@ impl Domain {
                     if !spend(budget) {
                         return Ok(false);
                     }
-                    let p = self.segment_split_point(x, y);
-                    let hint = self.dt.vertex_tet(x);
-                    if self.is_frozen_subsegment((x, y)) || !self.may_insert_at(p, hint) {
+                    let Some(p) = self.split_point_clear_of_frozen(x, y) else {
                         frozen_missing(status, &what)?;
                         return Ok(true);
-                    }
+                    };
                     self.split_subsegment(x, y, p, None)?;
                 }
             }
@@ -268,12 +264,10 @@ impl Domain {
             if !spend(budget) {
                 return Ok(false);
             }
-            let p = self.segment_split_point(x, y);
-            let hint = self.dt.vertex_tet(x);
-            if self.is_frozen_subsegment(seg_key(x, y)) || !self.may_insert_at(p, hint) {
+            let Some(p) = self.split_point_clear_of_frozen(x, y) else {
                 frozen_missing(status, &what)?;
                 return Ok(true);
-            }
+            };
             self.split_subsegment(x, y, p, None)?;
             self.dirty_tris.push(tri); // looked at again, as above
             return Ok(true);
@@ -284,12 +278,53 @@ impl Domain {
             return Ok(false);
         }
         let hint = self.dt.vertex_tet(tri[0]);
-        if !self.may_insert_at(p, hint) {
+        let Some(p) = self.facet_point_clear_of_frozen(f, p, [a, b, c], hint) else {
             frozen_missing(status, &what)?;
             return Ok(true);
-        }
+        };
         self.split_in_facet(f, p, hint, None)?;
         Ok(true)
+    }
+
+    /// Where to split subsegment ab: `segment_split_point`, or, when that point's insertion
+    /// would remove a frozen subfacet, the first point of ab at 0.4, 0.6, 0.3, 0.7, 0.2 or 0.8
+    /// of its length that does not. None for a frozen subsegment or when no point will do.
+    fn split_point_clear_of_frozen(&mut self, a: u32, b: u32) -> Option<DVec3> {
+        if self.is_frozen_subsegment(seg_key(a, b)) {
+            return None;
+        }
+        let hint = self.dt.vertex_tet(a);
+        let p = self.segment_split_point(a, b);
+        if self.may_insert_at(p, hint) {
+            return Some(p);
+        }
+        let (pa, pb) = (self.point(a), self.point(b));
+        [0.4, 0.6, 0.3, 0.7, 0.2, 0.8]
+            .into_iter()
+            .map(|t| pa + (pb - pa) * t)
+            .find(|&q| self.may_insert_at(q, hint))
+    }
+
+    /// `p` to split a subfacet with corners `corners` of facet `f`, or, when its insertion
+    /// would remove a frozen subfacet, the first of the subfacet's centroid and its points
+    /// halfway from there to each corner that the facet takes and that does not.
+    fn facet_point_clear_of_frozen(
+        &mut self,
+        f: u32,
+        p: DVec3,
+        corners: [DVec3; 3],
+        hint: Option<u32>,
+    ) -> Option<DVec3> {
+        if self.may_insert_at(p, hint) {
+            return Some(p);
+        }
+        let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
+        let mut candidates = vec![centroid];
+        candidates.extend(corners.iter().map(|&c| (centroid + c) * 0.5));
+        candidates.into_iter().find(|&q| {
+            let fm = &self.facets[f as usize];
+            fm.locate(q).is_some() && fm.can_insert(q).is_ok() && self.may_insert_at(q, hint)
+        })
     }
 
     /// Subsegments of facet `f` whose closed diametric ball contains `p` (up to rounding).
