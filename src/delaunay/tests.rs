@@ -146,6 +146,44 @@ fn grid_is_valid() {
     assert!((vol - 1331.0).abs() < 1e-9, "volume {vol}");
 }
 
+/// Ties broken by coordinates: a grid (cospherical everywhere) gives the same tets whatever
+/// the order of its points, and a subset's triangulation keeps every tet of the whole whose
+/// vertices it holds (what a partition's parts rely on).
+#[test]
+fn ties_by_coordinates_do_not_depend_on_the_order() {
+    let pts = grid(5);
+    let tets_of = |points: &[DVec3]| {
+        let (dt, _) = Delaunay::from_points_with(points, true).unwrap();
+        dt.validate().unwrap();
+        let mut tets: Vec<[[u64; 3]; 4]> = dt
+            .finite_tets()
+            .map(|t| {
+                let mut k = t.map(|v| dt.point(v).to_array().map(f64::to_bits));
+                k.sort_unstable();
+                k
+            })
+            .collect();
+        tets.sort_unstable();
+        tets
+    };
+    let whole = tets_of(&pts);
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    for _ in 0..3 {
+        let mut shuffled = pts.clone();
+        for i in (1..shuffled.len()).rev() {
+            shuffled.swap(i, rng.gen_range(0..=i));
+        }
+        assert_eq!(tets_of(&shuffled), whole);
+    }
+    // The points with x <= 2: every tet of the whole among them is one of theirs.
+    let half: Vec<DVec3> = pts.iter().copied().filter(|p| p.x <= 2.0).collect();
+    let sub: std::collections::HashSet<_> = tets_of(&half).into_iter().collect();
+    let inside = |k: &[[u64; 3]; 4]| k.iter().all(|c| f64::from_bits(c[0]) <= 2.0);
+    for t in whole.iter().filter(|t| inside(t)) {
+        assert!(sub.contains(t), "{t:?}");
+    }
+}
+
 #[test]
 fn grid_incremental_in_input_order_is_valid() {
     // Insert grid points one by one in scanline order: many hull-coplanar insertions.
