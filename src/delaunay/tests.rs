@@ -152,8 +152,13 @@ fn grid_is_valid() {
 #[test]
 fn ties_by_coordinates_do_not_depend_on_the_order() {
     let pts = grid(5);
+    // Inserted one at a time (the later, the higher a point's index rank), after a first tet.
     let tets_of = |points: &[DVec3]| {
-        let (dt, _) = Delaunay::from_points_with(points, true).unwrap();
+        let first = [0, 1, 2, 3].map(|k| points[k]);
+        let (mut dt, _) = Delaunay::from_points_with(&first, true).unwrap();
+        for &p in &points[4..] {
+            dt.insert(p, None).unwrap();
+        }
         dt.validate().unwrap();
         let mut tets: Vec<[[u64; 3]; 4]> = dt
             .finite_tets()
@@ -166,17 +171,37 @@ fn ties_by_coordinates_do_not_depend_on_the_order() {
         tets.sort_unstable();
         tets
     };
-    let whole = tets_of(&pts);
+    // A first tet that is not flat, then the grid in random orders.
+    let lead = |points: &mut Vec<DVec3>| {
+        for q in [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(0.0, 0.0, 1.0),
+        ]
+        .into_iter()
+        .rev()
+        {
+            let i = points.iter().position(|&p| p == q).unwrap();
+            let p = points.remove(i);
+            points.insert(0, p);
+        }
+    };
+    let mut ordered = pts.clone();
+    lead(&mut ordered);
+    let whole = tets_of(&ordered);
     let mut rng = ChaCha8Rng::seed_from_u64(7);
     for _ in 0..3 {
         let mut shuffled = pts.clone();
         for i in (1..shuffled.len()).rev() {
             shuffled.swap(i, rng.gen_range(0..=i));
         }
+        lead(&mut shuffled);
         assert_eq!(tets_of(&shuffled), whole);
     }
     // The points with x <= 2: every tet of the whole among them is one of theirs.
-    let half: Vec<DVec3> = pts.iter().copied().filter(|p| p.x <= 2.0).collect();
+    let mut half: Vec<DVec3> = pts.iter().copied().filter(|p| p.x <= 2.0).collect();
+    lead(&mut half);
     let sub: std::collections::HashSet<_> = tets_of(&half).into_iter().collect();
     let inside = |k: &[[u64; 3]; 4]| k.iter().all(|c| f64::from_bits(c[0]) <= 2.0);
     for t in whole.iter().filter(|t| inside(t)) {
