@@ -94,6 +94,9 @@ fn mesh_in_parts_with(
         let (mesh, report) = slivermesh::partition::mesh_part(&plan, part)
             .unwrap_or_else(|e| panic!("{model} part {part}: {e}"));
         let q = slivermesh::quality::measure(&mesh).unwrap();
+        if std::env::var("PARTITION_WHERE").is_ok() {
+            where_the_worst_are(&mesh);
+        }
         println!(
             "{model} {parts} parts: part {part}: {} tets, min dihedral {:.2}, refusals {}",
             mesh.tets.len(),
@@ -166,4 +169,58 @@ fn shared_poly_models_in_two_parts_keep_volume_and_regions() {
             serial.tets.len()
         );
     }
+}
+
+/// (Diagnosis) The smallest dihedral angles of the tets with a vertex on the part's open
+/// faces (the interface), on its boundary triangles, and elsewhere.
+fn where_the_worst_are(m: &TetMesh) {
+    let mut faces: HashMap<[u32; 3], usize> = HashMap::new();
+    for t in &m.tets {
+        for skip in 0..4 {
+            let mut f: Vec<u32> = (0..4).filter(|&i| i != skip).map(|i| t[i]).collect();
+            f.sort_unstable();
+            *faces.entry([f[0], f[1], f[2]]).or_default() += 1;
+        }
+    }
+    let mut on_boundary = vec![false; m.vertices.len()];
+    for b in &m.boundary {
+        b.iter().for_each(|&v| on_boundary[v as usize] = true);
+    }
+    let mut on_interface = vec![false; m.vertices.len()];
+    let boundary: std::collections::HashSet<[u32; 3]> = m
+        .boundary
+        .iter()
+        .map(|b| {
+            let mut k = *b;
+            k.sort_unstable();
+            k
+        })
+        .collect();
+    for (f, &k) in &faces {
+        if k == 1 && !boundary.contains(f) {
+            f.iter().for_each(|&v| on_interface[v as usize] = true);
+        }
+    }
+    let mut worst = [f64::MAX; 3];
+    for t in &m.tets {
+        let one = TetMesh {
+            vertices: t.iter().map(|&v| m.vertices[v as usize]).collect(),
+            tets: vec![[0, 1, 2, 3]],
+            tet_regions: vec![0],
+            ..Default::default()
+        };
+        let d = slivermesh::quality::measure(&one).unwrap().min_dihedral_deg;
+        let k = if t.iter().any(|&v| on_interface[v as usize]) {
+            0
+        } else if t.iter().any(|&v| on_boundary[v as usize]) {
+            1
+        } else {
+            2
+        };
+        worst[k] = worst[k].min(d);
+    }
+    println!(
+        "  worst at the interface {:.2}, at the boundary {:.2}, elsewhere {:.2}",
+        worst[0], worst[1], worst[2]
+    );
 }

@@ -114,7 +114,11 @@ pub fn mesh_part(plan: &Plan, part: usize) -> Result<(TetMesh, Report), MeshErro
             plan.parts()
         )));
     }
-    let (input, frozen) = part_plc::build(&plan.coarse, &plan.band, part)?;
+    let part_plc::PartPlc {
+        input,
+        frozen,
+        on_facets,
+    } = part_plc::build(&plan.coarse, &plan.band, part)?;
     let refine_params = Params {
         improve: false,
         ..plan.params.clone()
@@ -126,9 +130,15 @@ pub fn mesh_part(plan: &Plan, part: usize) -> Result<(TetMesh, Report), MeshErro
         &frozen,
         crate::refine::Unseeded::Hole,
     )?;
-    // Improved with its whole boundary fixed: the interface must stay the band's, and a part
-    // has no facet description of the domain's sides to slide on.
-    let mut mesh = crate::pipeline::improve(mesh, &mut report, None, &plan.params)?;
+    // Improved with its PLC's facets and their vertices (the isolated ones, last, are free to
+    // move like Steiner vertices): the interface's vertices are input vertices (fixed) and
+    // each of its triangles a facet of its own (no flip joins two), so it stays the band's;
+    // Steiner vertices on the domain's facets slide in them.
+    let facets_only = PlcInput {
+        vertices: input.vertices[..on_facets].to_vec(),
+        ..input
+    };
+    let mut mesh = crate::pipeline::improve(mesh, &mut report, Some(&facets_only), &plan.params)?;
     let keep: Vec<bool> = (mesh.boundary_markers.iter())
         .map(|&m| m != INTERFACE_MARKER)
         .collect();

@@ -18,12 +18,17 @@ fn key(p: DVec3) -> [u64; 3] {
     p.to_array().map(f64::to_bits)
 }
 
-/// Part `part`'s PLC and its frozen facets (indices into the PLC's facets).
-pub(super) fn build(
-    coarse: &Coarse,
-    band: &Band,
-    part: usize,
-) -> Result<(PlcInput, Vec<u32>), MeshError> {
+/// A part's PLC.
+pub(super) struct PartPlc {
+    pub input: PlcInput,
+    /// Its frozen facets (the interface's triangles): indices into `input.facets`.
+    pub frozen: Vec<u32>,
+    /// Its vertices on facets come first: this many (the others are isolated vertices).
+    pub on_facets: usize,
+}
+
+/// Part `part`'s PLC.
+pub(super) fn build(coarse: &Coarse, band: &Band, part: usize) -> Result<PartPlc, MeshError> {
     let m = &coarse.mesh;
     let mut face_parts: FxHashMap<[u32; 3], Vec<u32>> = FxHashMap::default();
     for t in 0..m.tets.len() {
@@ -115,7 +120,39 @@ pub(super) fn build(
         ..Default::default()
     }));
     let frozen = (first_frozen..input.facets.len() as u32).collect();
-    Ok((input, frozen))
+    let on_facets = facet_vertices_first(&mut input);
+    Ok(PartPlc {
+        input,
+        frozen,
+        on_facets,
+    })
+}
+
+/// Renumbers `input`'s vertices so that those of its facets come first (in their order),
+/// the isolated ones (coarse interior vertices, the band's seeds) after; returns how many
+/// are on facets.
+fn facet_vertices_first(input: &mut PlcInput) -> usize {
+    let mut on_facet = vec![false; input.vertices.len()];
+    for f in &input.facets {
+        for p in f.polygons.iter().chain(&f.hole_polygons) {
+            p.iter().for_each(|&v| on_facet[v as usize] = true);
+        }
+    }
+    let order: Vec<u32> = (0..input.vertices.len() as u32)
+        .filter(|&v| on_facet[v as usize])
+        .chain((0..input.vertices.len() as u32).filter(|&v| !on_facet[v as usize]))
+        .collect();
+    let mut new_id = vec![0u32; order.len()];
+    for (i, &v) in order.iter().enumerate() {
+        new_id[v as usize] = i as u32;
+    }
+    input.vertices = order.iter().map(|&v| input.vertices[v as usize]).collect();
+    for f in &mut input.facets {
+        for p in f.polygons.iter_mut().chain(f.hole_polygons.iter_mut()) {
+            p.iter_mut().for_each(|v| *v = new_id[*v as usize]);
+        }
+    }
+    on_facet.iter().filter(|&&b| b).count()
 }
 
 /// Puts the band's vertices on coarse edges (`Band::chains`) into the polygon edges of
