@@ -163,6 +163,8 @@ fn shared_poly_models_in_two_parts_keep_volume_and_regions() {
                 "{model} region {r}: {a} serial, {b} in parts"
             );
         }
+        // Measured 22.6-27.7 degrees.
+        assert!(worst > 18.0, "{model}: {worst}");
         println!(
             "{model}: {} tets in parts (serial {}), min dihedral {worst:.2}",
             whole.tets.len(),
