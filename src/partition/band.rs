@@ -1,7 +1,10 @@
-//! The band: the coarse tets around the interfaces between parts, meshed once with each tet's
-//! region paired with its part, so that the interfaces are internal facets refined from both
-//! sides. Its interface triangles become every part's frozen facets and its inner vertices
-//! the parts' seeds (the tets next to an interface start as the band's).
+//! The band: the whole coarse domain meshed once with each tet's region paired with its part,
+//! so that the interfaces are internal facets refined from both sides, for a spacing that is
+//! the run's next to the interfaces and grows away from them (so the band costs about a layer
+//! of final tets on each side of an interface, and its mesh there is a serial run's, with no
+//! artificial side of its own next to the interface). Its interface triangles become every
+//! part's frozen facets and its vertices next to an interface the parts' seeds (the tets
+//! next to an interface start as the band's).
 
 use super::coarse::{sorted_faces, Coarse};
 use super::INTERFACE_MARKER;
@@ -12,8 +15,8 @@ use crate::run::spacing::Spacing;
 use rustc_hash::{FxHashMap, FxHashSet};
 
 pub(super) struct Band {
-    /// Coarse tets in the band.
-    pub n_coarse_tets: usize,
+    /// The band's tets.
+    pub n_tets: usize,
     /// The refined band (region attributes are codes of (region, part) pairs).
     pub mesh: TetMesh,
     /// Per part: the band's triangles between it and another part (band vertex ids).
@@ -42,9 +45,8 @@ impl Band {
                 interface_faces.insert(*f);
             }
         }
-        let in_band: Vec<u32> = (0..m.tets.len() as u32)
-            .filter(|&t| m.tets[t as usize].iter().any(|&v| on_interface[v as usize]))
-            .collect();
+        let in_band: Vec<u32> = (0..m.tets.len() as u32).collect();
+        let near = NearInterfaces::new(m, &on_interface, spacing);
         // (region, part) -> code, in first-seen order (deterministic).
         let mut codes: FxHashMap<(i32, u32), i32> = FxHashMap::default();
         let mut part_of_code = vec![];
@@ -97,7 +99,7 @@ impl Band {
         let (mesh, _, segment_ends) = crate::refine::mesh_frozen_tracing_segments(
             &input,
             &band_params,
-            Some(spacing),
+            Some(&near),
             &[],
             crate::refine::Unseeded::Hole,
         )
@@ -112,14 +114,64 @@ impl Band {
         let part_of_tet: Vec<u32> = (mesh.tet_regions.iter())
             .map(|&c| part_of_code[(c - 1) as usize])
             .collect();
-        let (interface, seeds) = split_by_part(&mesh, &part_of_tet, coarse.parts);
+        let (interface, mut seeds) = split_by_part(&mesh, &part_of_tet, coarse.parts);
+        // Seeds only where the band is at the run's spacing.
+        for part_seeds in &mut seeds {
+            part_seeds.retain(|&v| near.is_fine(mesh.vertices[v as usize]));
+        }
         Ok(Band {
-            n_coarse_tets: in_band.len(),
+            n_tets: mesh.tets.len(),
             mesh,
             interface,
             seeds,
             chains,
         })
+    }
+}
+
+/// The band's spacing: the run's `f` next to the interfaces, growing away from them as the
+/// automatic spacing grades (the larger of `f` and the Lipschitz extension of f from the
+/// interfaces' coarse vertices).
+struct NearInterfaces<'a> {
+    f: &'a dyn Spacing,
+    grown: crate::refine::AutoSpacing,
+}
+
+/// How far above f the band's spacing may be at a seed: about one final layer from an
+/// interface.
+const SEED_SPACING_RATIO: f64 = 1.25;
+
+impl<'a> NearInterfaces<'a> {
+    fn new(m: &TetMesh, on_interface: &[bool], f: &'a dyn Spacing) -> Self {
+        let points: Vec<glam::DVec3> = (m.vertices.iter().zip(on_interface))
+            .filter(|(_, &on)| on)
+            .map(|(&p, _)| p)
+            .collect();
+        let mut h = vec![0.0; points.len()];
+        f.at_many(&points, &mut h);
+        let sized: Vec<(glam::DVec3, f64)> = points.into_iter().zip(h).collect();
+        NearInterfaces {
+            f,
+            grown: crate::refine::AutoSpacing::from_sizes(&sized),
+        }
+    }
+
+    /// Whether the band's spacing at `p` is close to the run's.
+    fn is_fine(&self, p: glam::DVec3) -> bool {
+        self.at(p) <= SEED_SPACING_RATIO * self.f.at(p)
+    }
+}
+
+impl Spacing for NearInterfaces<'_> {
+    fn at(&self, p: glam::DVec3) -> f64 {
+        self.f.at(p).max(self.grown.at(p))
+    }
+
+    fn at_many(&self, points: &[glam::DVec3], out: &mut [f64]) {
+        self.f.at_many(points, out);
+        for (o, &p) in out.iter_mut().zip(points) {
+            *o = o.max(self.grown.at(p));
+        }
     }
 }
 

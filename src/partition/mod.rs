@@ -67,7 +67,7 @@ impl Plan<'_> {
     pub fn sizes(&self) -> (usize, usize, usize) {
         (
             self.coarse.mesh.tets.len(),
-            self.band.n_coarse_tets,
+            self.band.n_tets,
             self.band.mesh.vertices.len(),
         )
     }

@@ -201,13 +201,14 @@ impl Domain {
         }
         self.record_facet_apexes();
         let acute = plc.acute_angles();
-        for a in acute
-            .segment_angles
-            .iter()
-            .filter(|a| a.degrees < SMALL_ANGLE_DEG)
-        {
-            self.small_angle_vertices.insert(a.vertex);
-        }
+        let small: Vec<u32> = (acute.segment_angles.iter())
+            .filter(|a| {
+                a.degrees < SMALL_ANGLE_DEG
+                    && !(a.segments.iter()).any(|&s| self.frozen_only(&self.segments[s]))
+            })
+            .map(|a| a.vertex)
+            .collect();
+        self.small_angle_vertices.extend(small);
         self.small_angle_segments.extend(
             (acute.dihedral_angles.iter())
                 .filter(|a| a.degrees < SMALL_ANGLE_DEG)
@@ -357,12 +358,26 @@ impl Domain {
         self.dt.point(v)
     }
 
-    /// Freezes `facets` (see [`Domain::frozen`]).
+    /// Freezes `facets` (see [`Domain::frozen`]). Segments of frozen facets only are never
+    /// split, so the angles between them are no features: they make no acute vertex (nor, in
+    /// `set_input_angles`, a small angle).
     pub fn freeze_facets(&mut self, facets: &[u32]) {
         for &f in facets {
             self.frozen[f as usize] = true;
         }
         self.any_frozen |= !facets.is_empty();
+        if self.any_frozen {
+            let open: Vec<Segment> = (self.segments.iter())
+                .filter(|s| !self.frozen_only(s))
+                .cloned()
+                .collect();
+            self.acute_vertices = acute_vertices_of(self.dt.points(), &open);
+        }
+    }
+
+    /// Whether every facet of segment `s` is frozen.
+    fn frozen_only(&self, s: &Segment) -> bool {
+        self.any_frozen && s.facets.iter().all(|&f| self.frozen[f as usize])
     }
 
     /// Whether the subfacet with sorted vertices `key` is one of a frozen facet.
