@@ -17,7 +17,7 @@ use rustc_hash::{FxHashMap, FxHashSet};
 pub(super) struct Band {
     /// The band's tets.
     pub n_tets: usize,
-    /// The refined band (region attributes are codes of (region, part) pairs).
+    /// The refined band's vertices (its tets are dropped once the parts' shares are known).
     pub mesh: TetMesh,
     /// Per part: the band's triangles between it and another part (band vertex ids).
     pub interface: Vec<Vec<[u32; 3]>>,
@@ -119,8 +119,14 @@ impl Band {
         for part_seeds in &mut seeds {
             part_seeds.retain(|&v| near.is_fine(mesh.vertices[v as usize]));
         }
+        let n_tets = mesh.tets.len();
+        // The parts need the band's points only: its tets go now.
+        let mesh = TetMesh {
+            vertices: mesh.vertices,
+            ..TetMesh::default()
+        };
         Ok(Band {
-            n_tets: mesh.tets.len(),
+            n_tets,
             mesh,
             interface,
             seeds,
