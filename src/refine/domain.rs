@@ -405,17 +405,22 @@ impl Domain {
             return None;
         }
         let (removed, _) = self.dt.cavity(cavity);
+        let on_boundary = |x: u32| {
+            x != crate::delaunay::INFINITE && self.kind[x as usize] != VertexKind::Volume
+        };
         for &t in removed {
             let v = self.dt.tet(t);
+            let boundary = v.map(on_boundary);
+            if boundary.iter().filter(|&&b| b).count() < 3 {
+                continue; // no face on the boundary (most cavity tets)
+            }
             let neighbors = self.dt.neighbors(t);
             for (i, n) in neighbors.into_iter().enumerate() {
-                if n < t || !removed.contains(&n) {
-                    continue; // each inner face once
+                let f = crate::delaunay::tables::FACE[i];
+                if n < t || !f.iter().all(|&l| boundary[l]) || !removed.contains(&n) {
+                    continue; // each inner boundary face once
                 }
-                let face = tri_key(crate::delaunay::tables::FACE[i].map(|l| v[l]));
-                if face.contains(&crate::delaunay::INFINITE) {
-                    continue;
-                }
+                let face = tri_key(f.map(|l| v[l]));
                 if let Some(&f) = self.subfacets.get(&face) {
                     if self.frozen[f as usize] {
                         return Some((f, face));
