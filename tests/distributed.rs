@@ -178,6 +178,11 @@ fn check_distributed(np: usize, name: &str, size: &str) {
     assert_eq!(tets as usize, mesh.tets.len());
     for r in ranks {
         assert!(r["seconds"].as_f64().unwrap() > 0.0 && r["peak_rss_mb"].as_f64().unwrap() > 0.0);
+        let (lo, hi) = (
+            r["min_dihedral_deg"].as_f64(),
+            r["max_dihedral_deg"].as_f64(),
+        );
+        assert!(lo.unwrap() > 0.0 && hi.unwrap() < 180.0, "{r}");
     }
     assert_eq!(
         json["global_vertices"].as_u64(),

@@ -100,16 +100,21 @@ fn run<C: mpi::traits::Communicator>(
         tets: part.mesh.tets.len() as u64,
         seconds: start.elapsed().as_secs_f64(),
         peak_rss_mb: super::rss::peak_rss_bytes().map_or(0.0, |b| b as f64 / 1e6),
+        min_dihedral_deg: part.report.dihedral_range()[0],
+        max_dihedral_deg: part.report.dihedral_range()[1],
     };
     let Some(ranks) = distributed::gather_stats(comm, stats)? else {
         return Ok(());
     };
     // Rank 0 alone from here.
     let n = &part.numbering;
+    let (min_dihedral, max_dihedral) = global_dihedral_range(&ranks);
     let extra = [
         ("ranks", serde_json::to_value(&ranks).map_err(here)?),
         ("global_vertices", n.n_vertices.into()),
         ("global_tets", n.n_tets.into()),
+        ("global_min_dihedral_deg", min_dihedral.into()),
+        ("global_max_dihedral_deg", max_dihedral.into()),
     ];
     println!("{}", ranks_table(&ranks, n.n_vertices, n.n_tets));
     match (whole, out) {
@@ -140,20 +145,33 @@ fn here(e: impl std::fmt::Display) -> Error {
     Error::here(e.to_string())
 }
 
-/// Rank 0's table of the ranks: tets, seconds, peak memory, and the global counts.
+/// The smallest and largest dihedral angles over all ranks.
+fn global_dihedral_range(ranks: &[RankStats]) -> (f64, f64) {
+    ranks.iter().fold((f64::MAX, f64::MIN), |(lo, hi), s| {
+        (lo.min(s.min_dihedral_deg), hi.max(s.max_dihedral_deg))
+    })
+}
+
+/// Rank 0's table of the ranks: tets, seconds, peak memory, dihedral range, and the global
+/// counts and dihedral range (the report below it is rank 0's part's).
 fn ranks_table(ranks: &[RankStats], vertices: u64, tets: u64) -> String {
     let mut out = format!(
-        "distributed run: {} ranks, {vertices} vertices, {tets} tets\n  rank {:>12} {:>10} {:>14}\n",
+        "distributed run: {} ranks, {vertices} vertices, {tets} tets\n  rank {:>12} {:>10} {:>14} {:>16}\n",
         ranks.len(),
         "tets",
         "seconds",
-        "peak RSS (MB)"
+        "peak RSS (MB)",
+        "dihedral (deg)"
     );
     for (r, s) in ranks.iter().enumerate() {
         out.push_str(&format!(
-            "  {r:>4} {:>12} {:>10.3} {:>14.1}\n",
-            s.tets, s.seconds, s.peak_rss_mb
+            "  {r:>4} {:>12} {:>10.3} {:>14.1} {:>7.2} / {:>6.2}\n",
+            s.tets, s.seconds, s.peak_rss_mb, s.min_dihedral_deg, s.max_dihedral_deg
         ));
     }
+    let (lo, hi) = global_dihedral_range(ranks);
+    out.push_str(&format!(
+        "  all ranks: dihedral min / max {lo:.2} / {hi:.2}; the report below is rank 0's part\n"
+    ));
     out
 }

@@ -111,6 +111,9 @@ pub struct RankStats {
     pub seconds: f64,
     /// Peak resident memory of the rank's process, in MB (0 where unknown).
     pub peak_rss_mb: f64,
+    /// The smallest and largest dihedral angles of the rank's tets, in degrees.
+    pub min_dihedral_deg: f64,
+    pub max_dihedral_deg: f64,
 }
 
 /// Every rank's `stats` on rank 0, in rank order (`None` on the other ranks; collective).
@@ -118,14 +121,22 @@ pub fn gather_stats<C: Communicator>(
     comm: &C,
     stats: RankStats,
 ) -> Result<Option<Vec<RankStats>>, Error> {
-    let row = [stats.tets as f64, stats.seconds, stats.peak_rss_mb];
+    let row = [
+        stats.tets as f64,
+        stats.seconds,
+        stats.peak_rss_mb,
+        stats.min_dihedral_deg,
+        stats.max_dihedral_deg,
+    ];
     let rows = collect::gather_varcount(comm, &row[..], "statistics")?;
     Ok(rows.map(|(rows, _)| {
-        rows.chunks_exact(3)
+        rows.chunks_exact(row.len())
             .map(|r| RankStats {
                 tets: r[0] as u64,
                 seconds: r[1],
                 peak_rss_mb: r[2],
+                min_dihedral_deg: r[3],
+                max_dihedral_deg: r[4],
             })
             .collect()
     }))
