@@ -26,6 +26,9 @@ pub(super) struct Band {
     /// The band's vertices on each coarse edge it split (coarse vertex ids, smaller first),
     /// from the smaller end to the larger.
     pub chains: FxHashMap<(u32, u32), Vec<u32>>,
+    /// Its vertices inside the domain's facets next to the interfaces, with the facet's
+    /// marker (`facet_points`).
+    pub facet_points: Vec<(u32, i32)>,
 }
 
 impl Band {
@@ -119,6 +122,7 @@ impl Band {
         for part_seeds in &mut seeds {
             part_seeds.retain(|&v| near.is_fine(mesh.vertices[v as usize]));
         }
+        let facet_points = facet_points(&mesh, &segment_ends, sub.vertices.len(), &near);
         let n_tets = mesh.tets.len();
         // The parts need the band's points only: its tets go now.
         let mesh = TetMesh {
@@ -131,8 +135,37 @@ impl Band {
             interface,
             seeds,
             chains,
+            facet_points,
         })
     }
+}
+
+/// The band's vertices inside a domain facet (not coarse, on no segment) where its spacing is
+/// the run's, with the facet's marker: a part's facet gets those inside it, so that its
+/// triangles next to the interface are the band's (without them a part's subfacet there can
+/// be one that no point may split without removing an interface triangle).
+fn facet_points(
+    mesh: &TetMesh,
+    segment_ends: &[Option<[u32; 2]>],
+    n_coarse: usize,
+    near: &NearInterfaces,
+) -> Vec<(u32, i32)> {
+    let mut marker_of: Vec<Option<i32>> = vec![None; mesh.vertices.len()];
+    let mut mixed = vec![false; mesh.vertices.len()];
+    for (b, &m) in mesh.boundary.iter().zip(&mesh.boundary_markers) {
+        for &v in b {
+            let v = v as usize;
+            if m == INTERFACE_MARKER || marker_of[v].is_some_and(|x| x != m) {
+                mixed[v] = true;
+            }
+            marker_of[v] = Some(m);
+        }
+    }
+    (0..mesh.vertices.len())
+        .filter(|&v| v >= n_coarse && !mixed[v] && segment_ends.get(v).is_some_and(|e| e.is_none()))
+        .filter_map(|v| Some((v as u32, marker_of[v]?)))
+        .filter(|&(v, _)| near.is_fine(mesh.vertices[v as usize]))
+        .collect()
 }
 
 /// The band's spacing: the run's `f` next to the interfaces, growing away from them as the

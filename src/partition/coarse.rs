@@ -48,7 +48,17 @@ impl Coarse {
         };
         let scaled = Scaled(spacing, COARSE_FACTOR);
         let (mesh, mut report) = crate::refine::mesh(input, &coarse_params, Some(&scaled), None)?;
-        let mesh = crate::pipeline::improve(mesh, &mut report, Some(input), &coarse_params)?;
+        let mut mesh = crate::pipeline::improve(mesh, &mut report, Some(input), &coarse_params)?;
+        // The coarse vertices become the band's and the parts' input vertices. A vertex slid
+        // in a facet on a coordinate plane can keep a residue far below the predicates' range
+        // (5e-33 where the plane is x = 0), which input validation rejects: it is that plane.
+        for p in &mut mesh.vertices {
+            for c in [&mut p.x, &mut p.y, &mut p.z] {
+                if c.abs() < crate::geom::MIN_COORD {
+                    *c = 0.0;
+                }
+            }
+        }
         if mesh.tets.len() < parts {
             return Err(MeshError::InvalidInput(format!(
                 "{parts} parts from a coarse mesh of {} tets: too many parts for this size",

@@ -113,6 +113,7 @@ pub(super) fn build(coarse: &Coarse, band: &Band, part: usize) -> Result<PartPlc
     }
     insert_chains(&mut input.facets, &global, &band.chains, &mut id_of);
     input.vertices = vertices;
+    add_facet_points(&mut input, band, &index);
     let first_frozen = input.facets.len() as u32;
     input.facets.extend(tris.iter().map(|t| Facet {
         polygons: vec![t.to_vec()],
@@ -153,6 +154,112 @@ fn facet_vertices_first(input: &mut PlcInput) -> usize {
         }
     }
     on_facet.iter().filter(|&&b| b).count()
+}
+
+/// Puts the band's points inside the domain's facets (`Band::facet_points`) into the part's
+/// facets that hold them, as lone points: a facet of the same marker whose plane the point is
+/// on (within 1e-9 of the facet's size: they were snapped to it) and inside whose polygon
+/// (holes left out) it lies in the facet's projection. This only picks where a point goes;
+/// the PLC's validation checks the result exactly.
+fn add_facet_points(input: &mut PlcInput, band: &Band, index: &FxHashMap<[u64; 3], u32>) {
+    let shapes: Vec<Option<FacetShape>> = (input.facets.iter())
+        .map(|f| FacetShape::of(f, &input.vertices))
+        .collect();
+    for &(v, marker) in &band.facet_points {
+        let p = band.mesh.vertices[v as usize];
+        if index.contains_key(&key(p)) {
+            continue;
+        }
+        let found = (input.facets.iter().zip(&shapes)).position(|(f, shape)| {
+            f.marker == marker
+                && shape
+                    .as_ref()
+                    .is_some_and(|s| s.holds(p, f, &input.vertices))
+        });
+        if let Some(k) = found {
+            input.vertices.push(p);
+            let id = input.vertices.len() as u32 - 1;
+            input.facets[k].polygons.push(vec![id]);
+        }
+    }
+}
+
+/// A facet's plane and bounding box, for [`add_facet_points`].
+struct FacetShape {
+    origin: DVec3,
+    normal: DVec3,
+    /// The coordinate axes of the projection (the normal's largest component dropped).
+    axes: [usize; 2],
+    lo: DVec3,
+    hi: DVec3,
+    size: f64,
+}
+
+impl FacetShape {
+    fn of(f: &Facet, vertices: &[DVec3]) -> Option<FacetShape> {
+        let outer = f.polygons.iter().find(|p| p.len() >= 3)?;
+        let pts: Vec<DVec3> = outer.iter().map(|&v| vertices[v as usize]).collect();
+        // Newell's normal: robust for a non-convex polygon.
+        let mut normal = DVec3::ZERO;
+        for (i, a) in pts.iter().enumerate() {
+            let b = pts[(i + 1) % pts.len()];
+            normal += DVec3::new(
+                (a.y - b.y) * (a.z + b.z),
+                (a.z - b.z) * (a.x + b.x),
+                (a.x - b.x) * (a.y + b.y),
+            );
+        }
+        let normal = normal.try_normalize()?;
+        let m = normal.abs();
+        let drop = if m.x >= m.y && m.x >= m.z {
+            0
+        } else if m.y >= m.z {
+            1
+        } else {
+            2
+        };
+        let axes = [[1, 2], [0, 2], [0, 1]][drop];
+        let (lo, hi) = pts
+            .iter()
+            .fold((pts[0], pts[0]), |(l, h), &q| (l.min(q), h.max(q)));
+        Some(FacetShape {
+            origin: pts[0],
+            normal,
+            axes,
+            lo,
+            hi,
+            size: (hi - lo).length(),
+        })
+    }
+
+    /// Whether `p` lies in facet `f`: on its plane, inside its polygons' even-odd area.
+    fn holds(&self, p: DVec3, f: &Facet, vertices: &[DVec3]) -> bool {
+        let margin = 1e-9 * self.size;
+        if (p - self.origin).dot(self.normal).abs() > margin
+            || p.cmplt(self.lo - DVec3::splat(margin)).any()
+            || p.cmpgt(self.hi + DVec3::splat(margin)).any()
+        {
+            return false;
+        }
+        let [u, w] = self.axes;
+        let mut inside = false;
+        for poly in f.polygons.iter().chain(&f.hole_polygons) {
+            if poly.len() < 3 {
+                continue;
+            }
+            for i in 0..poly.len() {
+                let a = vertices[poly[i] as usize];
+                let b = vertices[poly[(i + 1) % poly.len()] as usize];
+                if (a[w] > p[w]) != (b[w] > p[w]) {
+                    let x = a[u] + (p[w] - a[w]) / (b[w] - a[w]) * (b[u] - a[u]);
+                    if p[u] < x {
+                        inside = !inside;
+                    }
+                }
+            }
+        }
+        inside
+    }
 }
 
 /// Puts the band's vertices on coarse edges (`Band::chains`) into the polygon edges of
