@@ -161,7 +161,7 @@ fn shared_poly_models_in_two_parts_keep_volume_and_regions() {
                 "{model} region {r}: {a} serial, {b} in parts"
             );
         }
-        // Measured 23.9-31.0 degrees (serial: 32.8-37.3).
+        // Measured 23.9-31.0 degrees (serial: 26.0-37.3).
         assert!(worst > 18.0, "{model}: {worst}");
         println!(
             "{model}: {} tets in parts (serial {}), min dihedral {worst:.2}",
