@@ -405,9 +405,8 @@ impl Domain {
             return None;
         }
         let (removed, _) = self.dt.cavity(cavity);
-        let on_boundary = |x: u32| {
-            x != crate::delaunay::INFINITE && self.kind[x as usize] != VertexKind::Volume
-        };
+        let on_boundary =
+            |x: u32| x != crate::delaunay::INFINITE && self.kind[x as usize] != VertexKind::Volume;
         for &t in removed {
             let v = self.dt.tet(t);
             let boundary = v.map(on_boundary);
