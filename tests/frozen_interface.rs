@@ -4,13 +4,11 @@
 
 mod common;
 
-use slivermesh::mesh::TetMesh;
 use slivermesh::plc::{Facet, PlcInput};
 use slivermesh::run::params::Params;
 use slivermesh::run::spacing::ConstantSpacing;
 use slivermesh::DVec3;
 use spade::{DelaunayTriangulation, Point2, Triangulation};
-use std::collections::HashMap;
 
 /// The interface x = 0.5 of the box [0, 1]^3: an `n` x `n` grid on the square [0, 1]^2 (y, z),
 /// jittered (inside along both axes, on a side along it) so that no four points are
@@ -95,29 +93,6 @@ fn half(left: bool, n: usize) -> (PlcInput, usize) {
     (input, frozen)
 }
 
-/// The two meshes glued by vertex coordinates (bit for bit).
-fn glue(parts: &[TetMesh]) -> TetMesh {
-    let mut out = TetMesh::default();
-    let mut index: HashMap<[u64; 3], u32> = HashMap::new();
-    for m in parts {
-        let ids: Vec<u32> = m
-            .vertices
-            .iter()
-            .map(|p| {
-                let key = p.to_array().map(f64::to_bits);
-                *index.entry(key).or_insert_with(|| {
-                    out.vertices.push(*p);
-                    out.vertices.len() as u32 - 1
-                })
-            })
-            .collect();
-        out.tets
-            .extend(m.tets.iter().map(|t| t.map(|v| ids[v as usize])));
-        out.tet_regions.extend(&m.tet_regions);
-    }
-    out
-}
-
 #[test]
 fn two_halves_meshed_alone_conform_on_their_frozen_interface() {
     let n = 16;
@@ -161,19 +136,12 @@ fn two_halves_meshed_alone_conform_on_their_frozen_interface() {
         assert!(improved.min_dihedral_deg > 15.0, "left {left}");
         parts.push(mesh);
     }
-    let whole = glue(&parts);
+    let whole = common::glue_by_coordinates(&parts);
     common::check_orientation(&whole);
     assert!(common::rel_close(common::total_volume(&whole), 1.0, 1e-9));
     // Conforming: every face in at most two tets, and the faces of one tet are on the box's
     // sides (none left open on x = 0.5).
-    let mut faces: HashMap<[u32; 3], usize> = HashMap::new();
-    for t in &whole.tets {
-        for skip in 0..4 {
-            let mut f: Vec<u32> = (0..4).filter(|&i| i != skip).map(|i| t[i]).collect();
-            f.sort_unstable();
-            *faces.entry([f[0], f[1], f[2]]).or_default() += 1;
-        }
-    }
+    let faces = common::face_counts(&whole);
     let on_box = |v: u32| {
         let p = whole.vertices[v as usize];
         p.to_array().iter().any(|&c| c == 0.0 || c == 1.0)

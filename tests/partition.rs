@@ -6,52 +6,10 @@ mod common;
 use slivermesh::mesh::TetMesh;
 use slivermesh::run::params::Params;
 use slivermesh::run::spacing::ConstantSpacing;
-use std::collections::HashMap;
-
-/// The parts glued by vertex coordinates (bit for bit), boundary triangles once each.
-fn glue(parts: &[TetMesh]) -> TetMesh {
-    let mut out = TetMesh::default();
-    let mut index: HashMap<[u64; 3], u32> = HashMap::new();
-    let mut seen = std::collections::HashSet::new();
-    for m in parts {
-        let ids: Vec<u32> = m
-            .vertices
-            .iter()
-            .map(|p| {
-                *index
-                    .entry(p.to_array().map(f64::to_bits))
-                    .or_insert_with(|| {
-                        out.vertices.push(*p);
-                        out.vertices.len() as u32 - 1
-                    })
-            })
-            .collect();
-        out.tets
-            .extend(m.tets.iter().map(|t| t.map(|v| ids[v as usize])));
-        out.tet_regions.extend(&m.tet_regions);
-        for (b, &marker) in m.boundary.iter().zip(&m.boundary_markers) {
-            let b = b.map(|v| ids[v as usize]);
-            let mut k = b;
-            k.sort_unstable();
-            if seen.insert(k) {
-                out.boundary.push(b);
-                out.boundary_markers.push(marker);
-            }
-        }
-    }
-    out
-}
 
 /// Every face in at most two tets; the faces of one tet are boundary triangles.
 fn check_conforming(m: &TetMesh) {
-    let mut faces: HashMap<[u32; 3], usize> = HashMap::new();
-    for t in &m.tets {
-        for skip in 0..4 {
-            let mut f: Vec<u32> = (0..4).filter(|&i| i != skip).map(|i| t[i]).collect();
-            f.sort_unstable();
-            *faces.entry([f[0], f[1], f[2]]).or_default() += 1;
-        }
-    }
+    let faces = common::face_counts(m);
     let boundary: std::collections::HashSet<[u32; 3]> = m
         .boundary
         .iter()
@@ -109,7 +67,7 @@ fn mesh_in_parts_with(
     println!(
         "{model}: coarse {coarse} tets, band {band_tets} coarse tets, {band_vertices} vertices"
     );
-    (glue(&meshes), worst)
+    (common::glue_by_coordinates(&meshes), worst)
 }
 
 #[test]
@@ -174,14 +132,7 @@ fn shared_poly_models_in_two_parts_keep_volume_and_regions() {
 /// (Diagnosis) The smallest dihedral angles of the tets with a vertex on the part's open
 /// faces (the interface), on its boundary triangles, and elsewhere.
 fn where_the_worst_are(m: &TetMesh) {
-    let mut faces: HashMap<[u32; 3], usize> = HashMap::new();
-    for t in &m.tets {
-        for skip in 0..4 {
-            let mut f: Vec<u32> = (0..4).filter(|&i| i != skip).map(|i| t[i]).collect();
-            f.sort_unstable();
-            *faces.entry([f[0], f[1], f[2]]).or_default() += 1;
-        }
-    }
+    let faces = common::face_counts(m);
     let mut on_boundary = vec![false; m.vertices.len()];
     for b in &m.boundary {
         b.iter().for_each(|&v| on_boundary[v as usize] = true);

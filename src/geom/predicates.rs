@@ -592,11 +592,16 @@ pub fn insphere_sos(p: [DVec3; 4], ranks: [u32; 4], e: DVec3, rank_e: u32) -> bo
 /// Tie-break for an exact in-sphere zero; see [`insphere_sos`].
 #[cold]
 pub fn insphere_tie(p: [DVec3; 4], ranks: [u32; 4], e: DVec3, rank_e: u32) -> bool {
-    // Visit points by decreasing rank; the first one whose cofactor orientation is non-zero
-    // decides. Replacing p_i by e in the tet gives that cofactor's sign.
     let mut order = [0usize, 1, 2, 3, 4];
     let rank = |i: usize| if i == 4 { rank_e } else { ranks[i] };
     order.sort_unstable_by_key(|&i| std::cmp::Reverse(rank(i)));
+    insphere_tie_in_order(p, e, order)
+}
+
+/// The tie-break of [`insphere_tie`] with the points (0-3: `p`, 4: `e`) visited in `order`,
+/// the most perturbed first: the first one whose cofactor orientation is non-zero decides
+/// (replacing p_i by e in the tet gives that cofactor's sign).
+fn insphere_tie_in_order(p: [DVec3; 4], e: DVec3, order: [usize; 5]) -> bool {
     for &i in &order {
         if i == 4 {
             // e itself has the largest remaining lift: it is lifted above the sphere (outside).
@@ -609,7 +614,7 @@ pub fn insphere_tie(p: [DVec3; 4], ranks: [u32; 4], e: DVec3, rank_e: u32) -> bo
             return o > 0.0;
         }
     }
-    unreachable!("insphere_tie: the first four points must form a non-degenerate tet")
+    unreachable!("insphere tie-break: the first four points must form a non-degenerate tet")
 }
 
 /// [`insphere_tie`] with the points ranked by their coordinates (lexicographically, x first;
@@ -624,18 +629,7 @@ pub fn insphere_tie_by_coordinates(p: [DVec3; 4], e: DVec3) -> bool {
         let (a, b) = (point(i).to_array(), point(j).to_array());
         b.partial_cmp(&a).unwrap_or(Ordering::Equal)
     });
-    for &i in &order {
-        if i == 4 {
-            return false;
-        }
-        let mut q = p;
-        q[i] = e;
-        let o = orient3d(q[0], q[1], q[2], q[3]);
-        if o != 0.0 {
-            return o > 0.0;
-        }
-    }
-    unreachable!("insphere_tie_by_coordinates: the first four points must form a tet")
+    insphere_tie_in_order(p, e, order)
 }
 
 /// Why a coordinate was rejected.

@@ -262,3 +262,56 @@ pub fn tail(s: &str, n: usize) -> String {
     let lines: Vec<&str> = s.lines().collect();
     lines[lines.len().saturating_sub(n)..].join("\n")
 }
+
+/// How many tets hold each face (by sorted vertex triple).
+pub fn face_counts(m: &TetMesh) -> HashMap<[u32; 3], usize> {
+    let mut faces: HashMap<[u32; 3], usize> = HashMap::new();
+    for t in &m.tets {
+        for skip in 0..4 {
+            let mut f = [0; 3];
+            let mut k = 0;
+            for (i, &v) in t.iter().enumerate() {
+                if i != skip {
+                    f[k] = v;
+                    k += 1;
+                }
+            }
+            f.sort_unstable();
+            *faces.entry(f).or_default() += 1;
+        }
+    }
+    faces
+}
+
+/// Meshes meshed apart glued into one by their vertices' exact coordinates; boundary
+/// triangles once each.
+pub fn glue_by_coordinates(parts: &[TetMesh]) -> TetMesh {
+    let mut out = TetMesh::default();
+    let mut index: HashMap<[u64; 3], u32> = HashMap::new();
+    let mut seen = std::collections::HashSet::new();
+    for m in parts {
+        let ids: Vec<u32> = (m.vertices.iter())
+            .map(|p| {
+                *index
+                    .entry(p.to_array().map(f64::to_bits))
+                    .or_insert_with(|| {
+                        out.vertices.push(*p);
+                        out.vertices.len() as u32 - 1
+                    })
+            })
+            .collect();
+        out.tets
+            .extend(m.tets.iter().map(|t| t.map(|v| ids[v as usize])));
+        out.tet_regions.extend(&m.tet_regions);
+        for (b, &marker) in m.boundary.iter().zip(&m.boundary_markers) {
+            let b = b.map(|v| ids[v as usize]);
+            let mut k = b;
+            k.sort_unstable();
+            if seen.insert(k) {
+                out.boundary.push(b);
+                out.boundary_markers.push(marker);
+            }
+        }
+    }
+    out
+}
