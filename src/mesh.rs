@@ -19,6 +19,30 @@ pub struct TetMesh {
     pub boundary_markers: Vec<i32>,
 }
 
+impl TetMesh {
+    /// How many tets hold each face (by sorted vertex triple): 1 on the mesh's surface, 2
+    /// inside, more where the mesh does not conform.
+    pub fn face_counts(&self) -> rustc_hash::FxHashMap<[u32; 3], u32> {
+        let mut faces = rustc_hash::FxHashMap::default();
+        faces.reserve(2 * self.tets.len());
+        for t in &self.tets {
+            for skip in 0..4 {
+                let mut f = [0; 3];
+                let mut k = 0;
+                for (i, &v) in t.iter().enumerate() {
+                    if i != skip {
+                        f[k] = v;
+                        k += 1;
+                    }
+                }
+                f.sort_unstable();
+                *faces.entry(f).or_insert(0) += 1;
+            }
+        }
+        faces
+    }
+}
+
 /// The mid-edge nodes that make a [`TetMesh`] a mesh of ten-node (quadratic) tets.
 ///
 /// Node ids continue after the corner vertices: mid-edge node `k` is node

@@ -141,7 +141,7 @@ fn two_halves_meshed_alone_conform_on_their_frozen_interface() {
     assert!(common::rel_close(common::total_volume(&whole), 1.0, 1e-9));
     // Conforming: every face in at most two tets, and the faces of one tet are on the box's
     // sides (none left open on x = 0.5).
-    let faces = common::face_counts(&whole);
+    let faces = whole.face_counts();
     let on_box = |v: u32| {
         let p = whole.vertices[v as usize];
         p.to_array().iter().any(|&c| c == 0.0 || c == 1.0)

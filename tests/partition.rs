@@ -9,16 +9,8 @@ use slivermesh::run::spacing::ConstantSpacing;
 
 /// Every face in at most two tets; the faces of one tet are boundary triangles.
 fn check_conforming(m: &TetMesh) {
-    let faces = common::face_counts(m);
-    let boundary: std::collections::HashSet<[u32; 3]> = m
-        .boundary
-        .iter()
-        .map(|b| {
-            let mut k = *b;
-            k.sort_unstable();
-            k
-        })
-        .collect();
+    let faces = m.face_counts();
+    let boundary = common::boundary_keys(m);
     for (f, &k) in &faces {
         assert!(k <= 2, "face {f:?} in {k} tets");
         if k == 1 {
@@ -132,21 +124,13 @@ fn shared_poly_models_in_two_parts_keep_volume_and_regions() {
 /// (Diagnosis) The smallest dihedral angles of the tets with a vertex on the part's open
 /// faces (the interface), on its boundary triangles, and elsewhere.
 fn where_the_worst_are(m: &TetMesh) {
-    let faces = common::face_counts(m);
+    let faces = m.face_counts();
     let mut on_boundary = vec![false; m.vertices.len()];
     for b in &m.boundary {
         b.iter().for_each(|&v| on_boundary[v as usize] = true);
     }
     let mut on_interface = vec![false; m.vertices.len()];
-    let boundary: std::collections::HashSet<[u32; 3]> = m
-        .boundary
-        .iter()
-        .map(|b| {
-            let mut k = *b;
-            k.sort_unstable();
-            k
-        })
-        .collect();
+    let boundary = common::boundary_keys(m);
     for (f, &k) in &faces {
         if k == 1 && !boundary.contains(f) {
             f.iter().for_each(|&v| on_interface[v as usize] = true);

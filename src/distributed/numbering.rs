@@ -35,21 +35,7 @@ pub struct Numbering {
 
 /// Local ids of the vertices on faces of exactly one tet of `mesh`, ascending.
 fn surface_vertices(mesh: &TetMesh) -> Vec<u32> {
-    let mut faces: FxHashMap<[u32; 3], u32> = FxHashMap::default();
-    for t in &mesh.tets {
-        for skip in 0..4 {
-            let mut f = [0; 3];
-            let mut k = 0;
-            for (i, &v) in t.iter().enumerate() {
-                if i != skip {
-                    f[k] = v;
-                    k += 1;
-                }
-            }
-            f.sort_unstable();
-            *faces.entry(f).or_insert(0) += 1;
-        }
-    }
+    let faces = mesh.face_counts();
     let mut on = vec![false; mesh.vertices.len()];
     for (f, &n) in &faces {
         if n == 1 {

@@ -263,24 +263,15 @@ pub fn tail(s: &str, n: usize) -> String {
     lines[lines.len().saturating_sub(n)..].join("\n")
 }
 
-/// How many tets hold each face (by sorted vertex triple).
-pub fn face_counts(m: &TetMesh) -> HashMap<[u32; 3], usize> {
-    let mut faces: HashMap<[u32; 3], usize> = HashMap::new();
-    for t in &m.tets {
-        for skip in 0..4 {
-            let mut f = [0; 3];
-            let mut k = 0;
-            for (i, &v) in t.iter().enumerate() {
-                if i != skip {
-                    f[k] = v;
-                    k += 1;
-                }
-            }
-            f.sort_unstable();
-            *faces.entry(f).or_default() += 1;
-        }
-    }
-    faces
+/// The sorted vertex triples of a mesh's boundary triangles.
+pub fn boundary_keys(m: &TetMesh) -> std::collections::HashSet<[u32; 3]> {
+    (m.boundary.iter())
+        .map(|b| {
+            let mut k = *b;
+            k.sort_unstable();
+            k
+        })
+        .collect()
 }
 
 /// Meshes meshed apart glued into one by their vertices' exact coordinates; boundary
