@@ -188,6 +188,27 @@ fn check_distributed(np: usize, name: &str, size: &str) {
         json["global_vertices"].as_u64(),
         Some(mesh.vertices.len() as u64)
     );
+    // With the interfaces moved, every tet meets the serial run's smallest dihedral angle
+    // where that is the improvement target or less (above it, the serial run's extra margin
+    // is luck of a small model's few tets).
+    let serial_min = slivermesh::quality::measure(&serial)
+        .unwrap()
+        .min_dihedral_deg;
+    let parts_min = slivermesh::quality::measure(&mesh)
+        .unwrap()
+        .min_dihedral_deg;
+    let bound = serial_min.min(slivermesh::run::params::KEEP_IMPROVE_TARGET) - 0.05;
+    println!("{name} on {np} ranks: min dihedral {parts_min:.2}, serial {serial_min:.2}");
+    assert!(
+        parts_min >= bound,
+        "{name} on {np} ranks: {parts_min} < {bound}"
+    );
+    // (The file's coordinates are rounded to text.)
+    let reported = json["global_min_dihedral_deg"].as_f64().unwrap();
+    assert!(
+        (reported - parts_min).abs() < 1e-6,
+        "{reported} vs {parts_min}"
+    );
 
     // One piece per rank, named relative to the .pvtu, with global ids 0..N-1 without gaps.
     let pvtu = dir.join("parts.pvtu");

@@ -7,10 +7,25 @@ use slivermesh::mesh::TetMesh;
 use slivermesh::run::params::Params;
 use slivermesh::run::spacing::ConstantSpacing;
 
-/// Every face in at most two tets; the faces of one tet are boundary triangles.
+/// Every face in at most two tets; the faces of one tet are boundary triangles, and so are
+/// the faces between two regions (also where a region interface is a part interface).
 fn check_conforming(m: &TetMesh) {
     let faces = m.face_counts();
     let boundary = common::boundary_keys(m);
+    let mut region_of_face = std::collections::HashMap::new();
+    for (t, &r) in m.tets.iter().zip(&m.tet_regions) {
+        for skip in 0..4 {
+            let mut f: Vec<u32> = (0..4).filter(|&i| i != skip).map(|i| t[i]).collect();
+            f.sort_unstable();
+            let f = [f[0], f[1], f[2]];
+            if let Some(s) = region_of_face.insert(f, r) {
+                assert!(
+                    s == r || boundary.contains(&f),
+                    "face {f:?} between regions {s} and {r} is not a boundary triangle"
+                );
+            }
+        }
+    }
     for (f, &k) in &faces {
         assert!(k <= 2, "face {f:?} in {k} tets");
         if k == 1 {
@@ -39,7 +54,7 @@ fn mesh_in_parts_with(
         .unwrap_or_else(|e| panic!("{model}: {e}"));
     let (coarse, band_tets, band_vertices) = plan.sizes();
     let mut meshes = vec![];
-    let mut worst = f64::MAX;
+    let mut before = f64::MAX;
     for part in 0..parts {
         let (mesh, report) = slivermesh::partition::mesh_part(&plan, part)
             .unwrap_or_else(|e| panic!("{model} part {part}: {e}"));
@@ -53,13 +68,33 @@ fn mesh_in_parts_with(
             q.min_dihedral_deg,
             report.refusals.summary()
         );
-        worst = worst.min(q.min_dihedral_deg);
+        before = before.min(q.min_dihedral_deg);
         meshes.push(mesh);
     }
     println!(
-        "{model}: coarse {coarse} tets, band {band_tets} coarse tets, {band_vertices} vertices"
+        "{model}: coarse {coarse} tets, band {band_tets} coarse tets, {band_vertices} vertices; \
+         min dihedral {before:.2} before the interfaces move"
     );
-    (common::glue_by_coordinates(&meshes), worst)
+    let moved = slivermesh::partition::move_interfaces(&meshes, &params)
+        .unwrap_or_else(|e| panic!("{model}, moving the interfaces: {e}"));
+    let mut worst = f64::MAX;
+    for (part, mesh) in moved.iter().enumerate() {
+        // A small part can go whole to a lower one with its zone.
+        let Ok(q) = slivermesh::quality::measure(mesh) else {
+            println!("{model} {parts} parts, interfaces moved: part {part} is empty");
+            continue;
+        };
+        if std::env::var("PARTITION_WHERE").is_ok() {
+            where_the_worst_are(mesh);
+        }
+        println!(
+            "{model} {parts} parts, interfaces moved: part {part}: {} tets, min dihedral {:.2}",
+            mesh.tets.len(),
+            q.min_dihedral_deg
+        );
+        worst = worst.min(q.min_dihedral_deg);
+    }
+    (slivermesh::partition::glue(&moved).0, worst)
 }
 
 #[test]
@@ -75,6 +110,9 @@ fn cube_in_two_and_three_parts_is_conforming() {
             "cube {parts} parts: {} tets, min dihedral {worst:.2}",
             whole.tets.len()
         );
+        // With the interfaces moved, the serial run's 26.0 degrees (the improvement target);
+        // measured 26.01 in 2 and 3 parts (before moving them: 21.8 and 18.2).
+        assert!(worst > 25.5, "cube in {parts} parts: {worst}");
     }
 }
 
@@ -111,10 +149,14 @@ fn shared_poly_models_in_two_parts_keep_volume_and_regions() {
                 "{model} region {r}: {a} serial, {b} in parts"
             );
         }
-        // Measured 23.9-31.0 degrees (serial: 26.0-37.3).
-        assert!(worst > 18.0, "{model}: {worst}");
+        // Measured with the interfaces moved: 24.1 (tetgen_example, serial 26.0) and
+        // 26.05-31.01 on the others (serial 32.8-37.3); before moving them 23.9-31.0.
+        assert!(worst > 23.5, "{model}: {worst}");
+        let serial_min = slivermesh::quality::measure(&serial)
+            .unwrap()
+            .min_dihedral_deg;
         println!(
-            "{model}: {} tets in parts (serial {}), min dihedral {worst:.2}",
+            "{model}: {} tets in parts (serial {}), min dihedral {worst:.2} (serial {serial_min:.2})",
             whole.tets.len(),
             serial.tets.len()
         );

@@ -102,3 +102,36 @@ where
     }
     Ok(Some((all, offs)))
 }
+
+/// Every rank's `mesh`, on every rank, in rank order.
+pub fn all_gather_meshes<C: Communicator>(
+    comm: &C,
+    mesh: &crate::mesh::TetMesh,
+) -> Result<Vec<crate::mesh::TetMesh>, Error> {
+    let coords: Vec<f64> = mesh.vertices.iter().flat_map(|p| p.to_array()).collect();
+    let tets: Vec<u32> = mesh.tets.iter().flatten().copied().collect();
+    let boundary: Vec<u32> = mesh.boundary.iter().flatten().copied().collect();
+    let (coords, c_at) = all_gather_varcount(comm, &coords, "vertex coordinates")?;
+    let (tets, t_at) = all_gather_varcount(comm, &tets, "tet vertex ids")?;
+    let (regions, r_at) = all_gather_varcount(comm, &mesh.tet_regions, "tet regions")?;
+    let (boundary, b_at) = all_gather_varcount(comm, &boundary, "boundary vertex ids")?;
+    let (markers, m_at) = all_gather_varcount(comm, &mesh.boundary_markers, "boundary markers")?;
+    Ok((0..comm.size() as usize)
+        .map(|r| crate::mesh::TetMesh {
+            vertices: coords[c_at[r]..c_at[r + 1]]
+                .chunks_exact(3)
+                .map(|p| glam::DVec3::new(p[0], p[1], p[2]))
+                .collect(),
+            tets: tets[t_at[r]..t_at[r + 1]]
+                .chunks_exact(4)
+                .map(|t| [t[0], t[1], t[2], t[3]])
+                .collect(),
+            tet_regions: regions[r_at[r]..r_at[r + 1]].to_vec(),
+            boundary: boundary[b_at[r]..b_at[r + 1]]
+                .chunks_exact(3)
+                .map(|t| [t[0], t[1], t[2]])
+                .collect(),
+            boundary_markers: markers[m_at[r]..m_at[r + 1]].to_vec(),
+        })
+        .collect())
+}

@@ -2,7 +2,8 @@
 //! part of `crate::partition`'s plan, then the parts are numbered globally and written.
 //!
 //! - [`mesh_on`]: `partition::plan` (the same on every rank) and `partition::mesh_part` for
-//!   this rank, then [`numbering::number`]: global vertex and tet ids, and the vertices shared
+//!   this rank, the interfaces moved (the zones around them exchanged and improved again),
+//!   then [`numbering::number`]: global vertex and tet ids, and the vertices shared
 //!   with each neighbour rank.
 //! - [`output`]: one `.vtu` piece per rank with the global ids and the `.pvtu` naming them,
 //!   or the parts gathered on rank 0 into one mesh for any writer.
@@ -92,7 +93,9 @@ pub fn mesh_on<C: Communicator>(
     let meshed = crate::partition::plan(input, params, spacing, size)
         .and_then(|plan| crate::partition::mesh_part(&plan, rank))
         .map_err(|e| Error::here(format!("rank {rank}: {e}")));
-    let (mesh, report) = collect::agree(comm, meshed)?;
+    let (mesh, mut report) = collect::agree(comm, meshed)?;
+    let mesh = move_interfaces(comm, &mesh, params)?;
+    crate::partition::measure_part(&mut report, &mesh);
     let numbering = numbering::number(comm, &mesh)?;
     Ok(Part {
         rank,
@@ -101,6 +104,26 @@ pub fn mesh_on<C: Communicator>(
         report,
         numbering,
     })
+}
+
+/// This rank's part with the interfaces moved (`partition::move_interfaces`, collective):
+/// every rank's zone around its interfaces goes to every rank, each improves the pieces it
+/// owns and keeps them with the rest of its part. (The zones are a few layers of tets along
+/// the interfaces; every rank holds all of them for now, see docs/distributed.md.)
+fn move_interfaces<C: Communicator>(
+    comm: &C,
+    part: &TetMesh,
+    params: &Params,
+) -> Result<TetMesh, Error> {
+    let rank = comm.rank() as usize;
+    let cut = crate::partition::cut_zone(part);
+    let zones = collect::all_gather_meshes(comm, &cut.zone)?;
+    let mine = crate::partition::share_zones(&zones).swap_remove(rank);
+    drop(zones);
+    let improved = crate::partition::improve_zone(mine, params)
+        .map_err(|e| Error::here(format!("rank {rank}, moving the interfaces: {e}")));
+    let (improved, _) = collect::agree(comm, improved)?;
+    Ok(crate::partition::glue(&[cut.rest, improved]).0)
 }
 
 /// What rank 0 reports of each rank.

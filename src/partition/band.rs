@@ -12,15 +12,21 @@ use crate::mesh::TetMesh;
 use crate::run::error::MeshError;
 use crate::run::params::Params;
 use crate::run::spacing::Spacing;
+use glam::DVec3;
 use rustc_hash::{FxHashMap, FxHashSet};
+
+/// A band triangle between two parts (band vertex ids) and its marker.
+pub(super) type InterfaceTriangle = ([u32; 3], i32);
 
 pub(super) struct Band {
     /// The band's tets.
     pub n_tets: usize,
     /// The refined band's vertices (its tets are dropped once the parts' shares are known).
     pub mesh: TetMesh,
-    /// Per part: the band's triangles between it and another part (band vertex ids).
-    pub interface: Vec<Vec<[u32; 3]>>,
+    /// Per part: the band's triangles between it and another part (band vertex ids), with
+    /// their marker: `INTERFACE_MARKER`, or the region interface's where one lies there (the
+    /// parts keep those triangles in their output).
+    pub interface: Vec<Vec<InterfaceTriangle>>,
     /// Per part: band vertices inside it, on no facet of the band.
     pub seeds: Vec<Vec<u32>>,
     /// The band's vertices on each coarse edge it split (coarse vertex ids, smaller first),
@@ -53,6 +59,7 @@ impl Band {
         // (region, part) -> code, in first-seen order (deterministic).
         let mut codes: FxHashMap<(i32, u32), i32> = FxHashMap::default();
         let mut part_of_code = vec![];
+        let mut region_of_code = vec![];
         let mut sub = TetMesh::default();
         let mut local = vec![u32::MAX; m.vertices.len()];
         for &t in &in_band {
@@ -69,6 +76,7 @@ impl Band {
             let next = codes.len() as i32 + 1;
             let code = *codes.entry(key).or_insert_with(|| {
                 part_of_code.push(part);
+                region_of_code.push(key.0);
                 next
             });
             sub.tet_regions.push(code);
@@ -117,7 +125,19 @@ impl Band {
         let part_of_tet: Vec<u32> = (mesh.tet_regions.iter())
             .map(|&c| part_of_code[(c - 1) as usize])
             .collect();
-        let (interface, mut seeds) = split_by_part(&mesh, &part_of_tet, coarse.parts);
+        let region_interfaces = RegionInterfaces::new(m, &interface_faces);
+        let marker_of = |f: [u32; 3], tets: &[u32]| -> i32 {
+            let region = |t: u32| region_of_code[(mesh.tet_regions[t as usize] - 1) as usize];
+            match tets {
+                [a, b] if region(*a) != region(*b) => region_interfaces.marker(
+                    f.map(|v| mesh.vertices[v as usize]),
+                    region(*a),
+                    region(*b),
+                ),
+                _ => INTERFACE_MARKER,
+            }
+        };
+        let (interface, mut seeds) = split_by_part(&mesh, &part_of_tet, coarse.parts, &marker_of);
         // Seeds only where the band is at the run's spacing.
         for part_seeds in &mut seeds {
             part_seeds.retain(|&v| near.is_fine(mesh.vertices[v as usize]));
@@ -137,6 +157,58 @@ impl Band {
             chains,
             facet_points,
         })
+    }
+}
+
+/// The markers of the coarse mesh's region interfaces that lie on part interfaces, to give
+/// them back to the band's triangles there (the band marks every part interface alike).
+struct RegionInterfaces {
+    /// Per pair of regions (smaller first): the coarse faces between them, with their marker.
+    faces: FxHashMap<(i32, i32), Vec<MarkedTriangle>>,
+}
+
+/// A triangle's corners and its marker.
+type MarkedTriangle = ([DVec3; 3], i32);
+
+impl RegionInterfaces {
+    fn new(m: &TetMesh, part_interfaces: &FxHashSet<[u32; 3]>) -> Self {
+        let mut region_across: FxHashMap<[u32; 3], Vec<i32>> = FxHashMap::default();
+        for (t, tv) in m.tets.iter().enumerate() {
+            for f in sorted_faces(*tv) {
+                if part_interfaces.contains(&f) {
+                    region_across.entry(f).or_default().push(m.tet_regions[t]);
+                }
+            }
+        }
+        let mut faces: FxHashMap<(i32, i32), Vec<MarkedTriangle>> = FxHashMap::default();
+        for (b, &marker) in m.boundary.iter().zip(&m.boundary_markers) {
+            let mut k = *b;
+            k.sort_unstable();
+            if let Some(&[r, s]) = region_across.get(&k).map(|r| &r[..]) {
+                let pair = (r.min(s), r.max(s));
+                let corners = b.map(|v| m.vertices[v as usize]);
+                faces.entry(pair).or_default().push((corners, marker));
+            }
+        }
+        RegionInterfaces { faces }
+    }
+
+    /// The marker of the coarse face between regions `r` and `s` that holds the triangle
+    /// `tri` (the nearest to its centroid where the regions share several).
+    fn marker(&self, tri: [DVec3; 3], r: i32, s: i32) -> i32 {
+        let Some(faces) = self.faces.get(&(r.min(s), r.max(s))) else {
+            return INTERFACE_MARKER;
+        };
+        if faces.iter().all(|f| f.1 == faces[0].1) {
+            return faces[0].1;
+        }
+        let c = (tri[0] + tri[1] + tri[2]) / 3.0;
+        let distance = |[a, b, d]: [DVec3; 3]| {
+            crate::surface::oracle::closest_on_triangle(c, a, b, d).distance_squared(c)
+        };
+        (faces.iter())
+            .min_by(|x, y| distance(x.0).total_cmp(&distance(y.0)))
+            .map_or(INTERFACE_MARKER, |f| f.1)
     }
 }
 
@@ -220,7 +292,8 @@ fn split_by_part(
     mesh: &TetMesh,
     part_of_tet: &[u32],
     parts: usize,
-) -> (Vec<Vec<[u32; 3]>>, Vec<Vec<u32>>) {
+    marker_of: &dyn Fn([u32; 3], &[u32]) -> i32,
+) -> (Vec<Vec<InterfaceTriangle>>, Vec<Vec<u32>>) {
     let mut face_tets: FxHashMap<[u32; 3], Vec<u32>> = FxHashMap::default();
     for (t, &tv) in mesh.tets.iter().enumerate() {
         for f in sorted_faces(tv) {
@@ -228,17 +301,19 @@ fn split_by_part(
         }
     }
     // The interface's refined triangles, each given to the parts of the tets on its sides.
-    let mut interface = vec![vec![]; parts];
+    let mut interface: Vec<Vec<InterfaceTriangle>> = vec![vec![]; parts];
     for (b, &marker) in mesh.boundary.iter().zip(&mesh.boundary_markers) {
         if marker != INTERFACE_MARKER {
             continue;
         }
         let mut f = *b;
         f.sort_unstable();
-        for &t in face_tets.get(&f).into_iter().flatten() {
+        let tets = face_tets.get(&f).map_or(&[][..], |t| &t[..]);
+        let marker = marker_of(f, tets);
+        for &t in tets {
             let p = part_of_tet[t as usize] as usize;
-            if interface[p].last() != Some(&f) {
-                interface[p].push(f);
+            if interface[p].last().map(|l| l.0) != Some(f) {
+                interface[p].push((f, marker));
             }
         }
     }

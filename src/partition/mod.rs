@@ -14,11 +14,14 @@
 //!    inner vertices;
 //! 3. each part's PLC (`part_plc.rs`): its coarse tets' boundary with the band's interface
 //!    triangles as frozen facets, the band's vertices on its side as seeds; meshed alone
-//!    (`refine::mesh_frozen`) and improved with its boundary fixed.
+//!    (`refine::mesh_frozen`) and improved with its boundary fixed;
+//! 4. the interfaces moved (`zone.rs`): the tets around them cut out of the parts, shared
+//!    out and improved again with the old interfaces free.
 
 mod band;
 mod coarse;
 mod part_plc;
+mod zone;
 
 use crate::mesh::TetMesh;
 use crate::plc::PlcInput;
@@ -29,6 +32,7 @@ use crate::run::report::Report;
 use crate::run::spacing::Spacing;
 use band::Band;
 use coarse::Coarse;
+pub use zone::{cut_zone, glue, improve_zone, move_interfaces, share_zones, Cut, ZONE_LAYERS};
 
 /// Marker of the interface triangles in a part's PLC (left out of its output).
 const INTERFACE_MARKER: i32 = i32::MIN + 1;
@@ -106,7 +110,8 @@ pub fn plan<'s>(
 
 /// Meshes part `part` of `plan`: its tets, vertices numbered from 0, region attributes, and
 /// the domain's boundary and region-interface triangles (with markers) that are faces of its
-/// tets; the interface triangles it shares with other parts are the band's.
+/// tets; the interface triangles it shares with other parts are the band's. The report's
+/// region figures are left to [`measure_part`], once the interfaces have moved.
 pub fn mesh_part(plan: &Plan, part: usize) -> Result<(TetMesh, Report), MeshError> {
     if part >= plan.parts() {
         return Err(MeshError::InvalidInput(format!(
@@ -145,6 +150,11 @@ pub fn mesh_part(plan: &Plan, part: usize) -> Result<(TetMesh, Report), MeshErro
     let mut k = keep.iter();
     mesh.boundary.retain(|_| *k.next().unwrap_or(&true));
     mesh.boundary_markers.retain(|&m| m != INTERFACE_MARKER);
-    report.measure_regions(&mesh);
     Ok((mesh, report))
+}
+
+/// The report's shape and region figures for the part's final mesh.
+pub fn measure_part(report: &mut Report, mesh: &TetMesh) {
+    report.measure_shapes(mesh);
+    report.measure_regions(mesh);
 }

@@ -6,7 +6,6 @@
 
 use super::band::Band;
 use super::coarse::Coarse;
-use super::INTERFACE_MARKER;
 use crate::mesh::TetMesh;
 use crate::plc::{Facet, PlcInput};
 use crate::run::error::MeshError;
@@ -104,9 +103,9 @@ pub(super) fn build(coarse: &Coarse, band: &Band, part: usize) -> Result<PartPlc
             vertices.len() as u32 - 1
         })
     };
-    let tris: Vec<[u32; 3]> = band.interface[part]
+    let tris: Vec<([u32; 3], i32)> = band.interface[part]
         .iter()
-        .map(|t| t.map(&mut id_of))
+        .map(|(t, marker)| (t.map(&mut id_of), *marker))
         .collect();
     for &s in &band.seeds[part] {
         id_of(s);
@@ -115,9 +114,9 @@ pub(super) fn build(coarse: &Coarse, band: &Band, part: usize) -> Result<PartPlc
     input.vertices = vertices;
     add_facet_points(&mut input, band, &index);
     let first_frozen = input.facets.len() as u32;
-    input.facets.extend(tris.iter().map(|t| Facet {
+    input.facets.extend(tris.iter().map(|(t, marker)| Facet {
         polygons: vec![t.to_vec()],
-        marker: INTERFACE_MARKER,
+        marker: *marker,
         ..Default::default()
     }));
     let frozen = (first_frozen..input.facets.len() as u32).collect();
