@@ -75,7 +75,7 @@ fn mesh_in_parts_with(
         "{model}: coarse {coarse} tets, band {band_tets} coarse tets, {band_vertices} vertices; \
          min dihedral {before:.2} before the interfaces move"
     );
-    let moved = slivermesh::partition::move_interfaces(&meshes, &params)
+    let moved = slivermesh::partition::move_interfaces(&meshes, plan.params())
         .unwrap_or_else(|e| panic!("{model}, moving the interfaces: {e}"));
     let mut worst = f64::MAX;
     for (part, mesh) in moved.iter().enumerate() {
@@ -199,5 +199,36 @@ fn where_the_worst_are(m: &TetMesh) {
     println!(
         "  worst at the interface {:.2}, at the boundary {:.2}, elsewhere {:.2}",
         worst[0], worst[1], worst[2]
+    );
+}
+
+/// Approximate mode: `plan` makes the surface once and the parts mesh it in keep mode; with
+/// the interfaces moved every part is at the approximate mode's improvement target or above.
+#[test]
+fn fandisk_approximate_in_three_parts() {
+    let input = common::read_model("off/fandisk.off");
+    let params = Params {
+        surface_mode: slivermesh::run::params::SurfaceMode::Approximate,
+        ..Params::default()
+    };
+    let plan = slivermesh::partition::plan(&input, &params, None, 3).unwrap();
+    let parts: Vec<TetMesh> = (0..3)
+        .map(|p| slivermesh::partition::mesh_part(&plan, p).unwrap().0)
+        .collect();
+    let moved = slivermesh::partition::move_interfaces(&parts, plan.params()).unwrap();
+    let whole = slivermesh::partition::glue(&moved).0;
+    common::check_orientation(&whole);
+    check_conforming(&whole);
+    // Measured 20.84 degrees after moving the interfaces, 14.45 before (serial 20.00).
+    let min = slivermesh::quality::measure(&whole)
+        .unwrap()
+        .min_dihedral_deg;
+    println!(
+        "fandisk in 3 parts: {} tets, min dihedral {min:.2}",
+        whole.tets.len()
+    );
+    assert!(
+        min >= slivermesh::run::params::APPROXIMATE_IMPROVE_TARGET,
+        "{min}"
     );
 }

@@ -342,6 +342,34 @@ pub fn remesh(
     crit: VolumeCriteria,
     progress: Option<Progress>,
 ) -> Result<(Remeshed, VolumeMesh), MeshError> {
+    remesh_with(input, params, spacing, |mesher| {
+        mesher.run_with_volume(crit, progress)
+    })
+}
+
+/// The new boundary alone, as a PLC of triangles, and the cells' automatic spacing (graded
+/// from the surface) when `spacing` is None: what partitioned meshing meshes in keep mode.
+/// The cell level's refinement of the surface is left out, so its triangles are the surface
+/// level's.
+pub fn boundary_only(
+    input: &PlcInput,
+    params: &Params,
+    spacing: Option<&dyn Spacing>,
+) -> Result<(PlcInput, Option<AutoSpacing>), MeshError> {
+    let user_spacing = spacing.is_some();
+    let (remeshed, volume) = remesh_with(input, params, spacing, |mesher| {
+        mesher.run_surface_only(user_spacing)
+    })?;
+    Ok((remeshed.boundary, volume.spacing))
+}
+
+/// Steps 1-3, then `run` on the surface mesher.
+fn remesh_with(
+    input: &PlcInput,
+    params: &Params,
+    spacing: Option<&dyn Spacing>,
+    run: impl FnOnce(SurfaceMesher) -> Result<(restricted::Boundary, VolumeMesh), MeshError>,
+) -> Result<(Remeshed, VolumeMesh), MeshError> {
     let start = std::time::Instant::now();
     params.check().map_err(MeshError::InvalidInput)?;
     let source = Source::read(input, params)?;
@@ -406,7 +434,7 @@ pub fn remesh(
         &params.region_sizes,
     )?);
     mesher.set_marker_caps(marker_caps.as_ref());
-    let (mut b, volume) = mesher.run_with_volume(crit, progress)?;
+    let (mut b, volume) = run(mesher)?;
 
     let boundary = boundary_plc(input, &b, &surface, &features);
     let small_corners: Vec<_> = curves

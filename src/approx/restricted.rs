@@ -470,6 +470,33 @@ impl<'a> SurfaceMesher<'a> {
         Ok((boundary, volume))
     }
 
+    /// The surface level alone (no cell refined): the boundary, and in an otherwise empty
+    /// volume the cells' automatic spacing unless the caller gave one (`user_spacing`).
+    pub fn run_surface_only(
+        mut self,
+        user_spacing: bool,
+    ) -> Result<(Boundary, VolumeMesh), MeshError> {
+        let start = std::time::Instant::now();
+        let (faces, stop_reason) = self.rounds(&mut Self::refine)?;
+        if let Some(reason) = stop_reason {
+            return Err(MeshError::InvalidInput(format!(
+                "surface mode approximate: {reason}"
+            )));
+        }
+        let spacing = (!user_spacing).then(|| self.surface_sizes(&faces));
+        let boundary = self.boundary(faces, None);
+        let volume = VolumeMesh {
+            vertices: vec![],
+            tets: vec![],
+            regions: vec![],
+            spacing,
+            refusals: Default::default(),
+            seconds_surface: start.elapsed().as_secs_f64(),
+            seconds_volume: 0.0,
+        };
+        Ok((boundary, volume))
+    }
+
     /// Runs `refine` and extracts the boundary, fixing what breaks it, until it is a closed
     /// 2-manifold of surface vertices (and, before the cell level, within the distance bound
     /// of every input sample): CGAL's manifold criterion, driven to the end. Each round must

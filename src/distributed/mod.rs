@@ -91,10 +91,13 @@ pub fn mesh_on<C: Communicator>(
     let rank = comm.rank() as usize;
     let size = comm.size() as usize;
     let meshed = crate::partition::plan(input, params, spacing, size)
-        .and_then(|plan| crate::partition::mesh_part(&plan, rank))
+        .and_then(|plan| {
+            let (mesh, report) = crate::partition::mesh_part(&plan, rank)?;
+            Ok((mesh, report, plan.params().clone()))
+        })
         .map_err(|e| Error::here(format!("rank {rank}: {e}")));
-    let (mesh, mut report) = collect::agree(comm, meshed)?;
-    let mesh = move_interfaces(comm, &mesh, params)?;
+    let (mesh, mut report, part_params) = collect::agree(comm, meshed)?;
+    let mesh = move_interfaces(comm, &mesh, &part_params)?;
     crate::partition::measure_part(&mut report, &mesh);
     let numbering = numbering::number(comm, &mesh)?;
     Ok(Part {

@@ -67,6 +67,13 @@ impl Plan<'_> {
         self.coarse.parts
     }
 
+    /// The parameters the parts are meshed and improved with (keep mode: in approximate mode
+    /// the parts mesh the boundary the plan made); the interfaces' zones are improved with
+    /// them too.
+    pub fn params(&self) -> &Params {
+        &self.params
+    }
+
     /// Coarse tets, band tets and band vertices (for the report).
     pub fn sizes(&self) -> (usize, usize, usize) {
         (
@@ -77,7 +84,9 @@ impl Plan<'_> {
     }
 }
 
-/// Prepares the partition of `input` into `parts` parts (keep mode only for now).
+/// Prepares the partition of `input` into `parts` parts. In approximate mode the surface is
+/// made once here (`approx::boundary_only`: the new boundary and the cells' automatic spacing
+/// graded from it) and the parts mesh that boundary in keep mode.
 pub fn plan<'s>(
     input: &PlcInput,
     params: &Params,
@@ -89,19 +98,33 @@ pub fn plan<'s>(
             "a partition needs at least one part".into(),
         ));
     }
-    if params.surface_mode != SurfaceMode::Keep {
-        return Err(MeshError::InvalidInput(
-            "partitioned meshing supports the keep surface mode only (so far)".into(),
-        ));
-    }
-    let spacing = match spacing {
-        Some(s) => PartSpacing::Given(s),
-        None => PartSpacing::Auto(crate::refine::auto_spacing(input, params)?),
+    let (boundary, spacing, params) = match params.surface_mode {
+        SurfaceMode::Keep => {
+            let spacing = match spacing {
+                Some(s) => PartSpacing::Given(s),
+                None => PartSpacing::Auto(crate::refine::auto_spacing(input, params)?),
+            };
+            (None, spacing, params.clone())
+        }
+        SurfaceMode::Approximate => {
+            let (boundary, auto) = crate::approx::boundary_only(input, params, spacing)?;
+            let spacing = match (spacing, auto) {
+                (Some(s), _) => PartSpacing::Given(s),
+                (None, Some(a)) => PartSpacing::Auto(a),
+                (None, None) => PartSpacing::Auto(crate::refine::auto_spacing(&boundary, params)?),
+            };
+            let keep = Params {
+                surface_mode: SurfaceMode::Keep,
+                ..params.clone()
+            };
+            (Some(boundary), spacing, keep)
+        }
     };
-    let coarse = Coarse::new(input, params, spacing.get(), parts)?;
-    let band = Band::new(&coarse, params, spacing.get())?;
+    let input = boundary.as_ref().unwrap_or(input);
+    let coarse = Coarse::new(input, &params, spacing.get(), parts)?;
+    let band = Band::new(&coarse, &params, spacing.get())?;
     Ok(Plan {
-        params: params.clone(),
+        params,
         spacing,
         coarse,
         band,

@@ -157,7 +157,7 @@ impl SurfaceMesher<'_> {
 
     /// The default cell spacing: at each surface vertex the mean length of its boundary
     /// edges, extended inwards with keep mode's grading.
-    fn surface_sizes(&self, faces: &[super::FaceRef]) -> AutoSpacing {
+    pub(super) fn surface_sizes(&self, faces: &[super::FaceRef]) -> AutoSpacing {
         let mut sum: FxHashMap<u32, (f64, f64)> = FxHashMap::default();
         for &(t, i) in faces {
             let tv = self.dt.tet(t);
