@@ -92,12 +92,13 @@ pub fn mesh_on<C: Communicator>(
     let size = comm.size() as usize;
     let meshed = crate::partition::plan(input, params, spacing, size)
         .and_then(|plan| {
-            let (mesh, report) = crate::partition::mesh_part(&plan, rank)?;
-            Ok((mesh, report, plan.params().clone()))
+            let part = crate::partition::mesh_part(&plan, rank)?;
+            Ok((part, plan.params().clone()))
         })
         .map_err(|e| Error::here(format!("rank {rank}: {e}")));
-    let (mesh, mut report, part_params) = collect::agree(comm, meshed)?;
-    let mesh = move_interfaces(comm, &mesh, &part_params)?;
+    let (part, part_params) = collect::agree(comm, meshed)?;
+    let mut report = part.report;
+    let mesh = move_interfaces(comm, &part.mesh, &part.interface, &part_params)?;
     crate::partition::measure_part(&mut report, &mesh);
     let numbering = numbering::number(comm, &mesh)?;
     Ok(Part {
@@ -116,10 +117,11 @@ pub fn mesh_on<C: Communicator>(
 fn move_interfaces<C: Communicator>(
     comm: &C,
     part: &TetMesh,
+    interface: &[[u32; 3]],
     params: &Params,
 ) -> Result<TetMesh, Error> {
     let rank = comm.rank() as usize;
-    let cut = crate::partition::cut_zone(part);
+    let cut = crate::partition::cut_zone(part, interface);
     let zones = collect::all_gather_meshes(comm, &cut.zone)?;
     let mine = crate::partition::share_zones(&zones).swap_remove(rank);
     drop(zones);

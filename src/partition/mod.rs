@@ -32,7 +32,17 @@ use crate::run::report::Report;
 use crate::run::spacing::Spacing;
 use band::Band;
 use coarse::Coarse;
+use rustc_hash::FxHashSet;
 pub use zone::{cut_zone, glue, improve_zone, move_interfaces, share_zones, Cut, ZONE_LAYERS};
+
+/// One part as [`mesh_part`] gives it.
+pub struct MeshedPart {
+    pub mesh: TetMesh,
+    pub report: Report,
+    /// The part's triangles on its interfaces with other parts (vertex ids of `mesh`): faces
+    /// of one tet of it, in `mesh.boundary` only where a region interface lies on them.
+    pub interface: Vec<[u32; 3]>,
+}
 
 /// Marker of the interface triangles in a part's PLC (left out of its output).
 const INTERFACE_MARKER: i32 = i32::MIN + 1;
@@ -135,7 +145,7 @@ pub fn plan<'s>(
 /// the domain's boundary and region-interface triangles (with markers) that are faces of its
 /// tets; the interface triangles it shares with other parts are the band's. The report's
 /// region figures are left to [`measure_part`], once the interfaces have moved.
-pub fn mesh_part(plan: &Plan, part: usize) -> Result<(TetMesh, Report), MeshError> {
+pub fn mesh_part(plan: &Plan, part: usize) -> Result<MeshedPart, MeshError> {
     if part >= plan.parts() {
         return Err(MeshError::InvalidInput(format!(
             "part {part} of a plan of {} parts",
@@ -166,14 +176,37 @@ pub fn mesh_part(plan: &Plan, part: usize) -> Result<(TetMesh, Report), MeshErro
         vertices: input.vertices[..on_facets].to_vec(),
         ..input
     };
+    let frozen_corners: FxHashSet<[[u64; 3]; 3]> = (frozen.iter())
+        .map(|&f| {
+            corner_key(
+                &facets_only.facets[f as usize].polygons[0],
+                &facets_only.vertices,
+            )
+        })
+        .collect();
     let mut mesh = crate::pipeline::improve(mesh, &mut report, Some(&facets_only), &plan.params)?;
+    let interface: Vec<[u32; 3]> = (mesh.boundary.iter())
+        .filter(|b| frozen_corners.contains(&corner_key(&b[..], &mesh.vertices)))
+        .copied()
+        .collect();
     let keep: Vec<bool> = (mesh.boundary_markers.iter())
         .map(|&m| m != INTERFACE_MARKER)
         .collect();
     let mut k = keep.iter();
     mesh.boundary.retain(|_| *k.next().unwrap_or(&true));
     mesh.boundary_markers.retain(|&m| m != INTERFACE_MARKER);
-    Ok((mesh, report))
+    Ok(MeshedPart {
+        mesh,
+        report,
+        interface,
+    })
+}
+
+/// A triangle's corners' coordinate bits, sorted (the frozen triangles keep their corners).
+fn corner_key(tri: &[u32], vertices: &[glam::DVec3]) -> [[u64; 3]; 3] {
+    let mut k = [0, 1, 2].map(|i| vertices[tri[i] as usize].to_array().map(f64::to_bits));
+    k.sort_unstable();
+    k
 }
 
 /// The report's shape and region figures for the part's final mesh.

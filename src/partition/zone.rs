@@ -10,6 +10,7 @@
 //! Each connected piece of the glued zone goes to the lowest part among its tets' parts, so
 //! every piece has one owner and the result is the same whichever rank computes it.
 
+use super::MeshedPart;
 use crate::mesh::TetMesh;
 use crate::run::error::MeshError;
 use crate::run::params::Params;
@@ -71,9 +72,12 @@ fn open_faces(mesh: &TetMesh) -> Vec<[u32; 3]> {
 /// The tets of `mesh` where `keep` is true, with the vertices they use (numbered from 0 in
 /// order) and the boundary triangles that are faces of them.
 fn sub_mesh(mesh: &TetMesh, keep: &[bool]) -> TetMesh {
+    let boundary_index: FxHashMap<[u32; 3], u32> = (mesh.boundary.iter().enumerate())
+        .map(|(i, &b)| (key(b), i as u32))
+        .collect();
+    let mut boundary_kept = vec![false; mesh.boundary.len()];
     let mut id = vec![u32::MAX; mesh.vertices.len()];
     let mut out = TetMesh::default();
-    let mut faces = FxHashSet::default();
     for (t, tv) in mesh.tets.iter().enumerate() {
         if !keep[t] {
             continue;
@@ -85,26 +89,31 @@ fn sub_mesh(mesh: &TetMesh, keep: &[bool]) -> TetMesh {
             }
             id[v as usize]
         });
-        for skip in 0..4 {
-            faces.insert(key(face(tv, skip)));
+        if !boundary_index.is_empty() {
+            for skip in 0..4 {
+                if let Some(&b) = boundary_index.get(&key(face(tv, skip))) {
+                    boundary_kept[b as usize] = true;
+                }
+            }
         }
         out.tets.push(new);
         out.tet_regions.push(mesh.tet_regions[t]);
     }
-    for (b, &m) in mesh.boundary.iter().zip(&mesh.boundary_markers) {
-        if faces.contains(&key(*b)) {
-            out.boundary.push(b.map(|v| id[v as usize]));
-            out.boundary_markers.push(m);
-        }
+    for ((b, &m), _) in (mesh.boundary.iter().zip(&mesh.boundary_markers))
+        .zip(&boundary_kept)
+        .filter(|(_, &kept)| kept)
+    {
+        out.boundary.push(b.map(|v| id[v as usize]));
+        out.boundary_markers.push(m);
     }
     out
 }
 
-/// Cuts a part's mesh (as `partition::mesh_part` gives it: its interface faces are the faces
-/// of one tet that are not boundary triangles) into its zone and the rest.
-pub fn cut_zone(part: &TetMesh) -> Cut {
+/// Cuts a part's mesh into its zone and the rest; `interface` holds its triangles on its
+/// interfaces (`MeshedPart::interface`).
+pub fn cut_zone(part: &TetMesh, interface: &[[u32; 3]]) -> Cut {
     let mut near = vec![false; part.vertices.len()];
-    for f in open_faces(part) {
+    for f in interface {
         f.iter().for_each(|&v| near[v as usize] = true);
     }
     let mut in_zone = vec![false; part.tets.len()];
@@ -252,8 +261,10 @@ pub fn improve_zone(zone: TetMesh, params: &Params) -> Result<(TetMesh, ImproveS
 /// The parts with their interfaces moved, in one process (`crate::distributed` does the
 /// same with the zones exchanged between ranks): each part's zone cut out, the zones shared
 /// out, improved, and glued to the rests.
-pub fn move_interfaces(parts: &[TetMesh], params: &Params) -> Result<Vec<TetMesh>, MeshError> {
-    let cuts: Vec<Cut> = parts.iter().map(cut_zone).collect();
+pub fn move_interfaces(parts: &[MeshedPart], params: &Params) -> Result<Vec<TetMesh>, MeshError> {
+    let cuts: Vec<Cut> = (parts.iter())
+        .map(|p| cut_zone(&p.mesh, &p.interface))
+        .collect();
     let zones: Vec<TetMesh> = cuts.iter().map(|c| c.zone.clone()).collect();
     let shares = share_zones(&zones);
     let mut out = vec![];
