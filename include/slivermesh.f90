@@ -25,7 +25,8 @@
 !>    Fortran wrappers that add the terminating NUL; the raw bind(C) ones are *_c.
 module slivermesh
   use, intrinsic :: iso_c_binding, only: c_ptr, c_funptr, c_null_ptr, c_null_char, c_char, &
-                                         c_double, c_int32_t, c_size_t, c_associated, c_f_pointer
+                                         c_double, c_int32_t, c_int64_t, c_size_t, c_associated, &
+                                         c_f_pointer
   implicit none
   private
 
@@ -249,6 +250,35 @@ module slivermesh
       integer(c_int32_t) :: s
     end function sm_refine
 
+    !> Distributed meshing (a library built with the cargo feature mpi only): every rank of
+    !> the communicator comm (the integer handle, e.g. MPI_COMM_WORLD or comm%MPI_VAL) meshes
+    !> its part; see sm_refine_mpi in slivermesh.h.
+    function sm_refine_mpi(m, comm) bind(C, name="sm_refine_mpi") result(s)
+      import :: c_ptr, c_int32_t
+      type(c_ptr), value :: m
+      integer(c_int32_t), value :: comm
+      integer(c_int32_t) :: s
+    end function sm_refine_mpi
+
+    !> Global id of each of this rank's vertices after sm_refine_mpi (ids(n_vertices)).
+    function sm_get_global_vertex_ids(m, ids, capacity) &
+        bind(C, name="sm_get_global_vertex_ids") result(s)
+      import :: c_ptr, c_int64_t, c_size_t, c_int32_t
+      type(c_ptr), value :: m
+      integer(c_int64_t), intent(out) :: ids(*)
+      integer(c_size_t), value :: capacity
+      integer(c_int32_t) :: s
+    end function sm_get_global_vertex_ids
+
+    !> Global vertex and tet counts and the global id of this rank's first tet.
+    function sm_global_counts(m, n_vertices, n_tets, first_tet) &
+        bind(C, name="sm_global_counts") result(s)
+      import :: c_ptr, c_int64_t, c_int32_t
+      type(c_ptr), value :: m
+      integer(c_int64_t), intent(out) :: n_vertices, n_tets, first_tet
+      integer(c_int32_t) :: s
+    end function sm_global_counts
+
     function sm_num_vertices(m) bind(C, name="sm_num_vertices") result(n)
       import :: c_ptr, c_size_t
       type(c_ptr), value :: m
@@ -398,7 +428,8 @@ module slivermesh
             sm_set_spacing_const, sm_set_spacing_mesh, sm_set_region_size, sm_set_marker_size, &
             sm_set_existing_mesh, &
             sm_set_param_c, sm_get_param_c, sm_set_progress_cb, &
-            sm_refine, sm_num_vertices, sm_num_tets, sm_num_boundary_faces, sm_get_vertices, &
+            sm_refine, sm_refine_mpi, sm_get_global_vertex_ids, sm_global_counts, &
+            sm_num_vertices, sm_num_tets, sm_num_boundary_faces, sm_get_vertices, &
             sm_get_tets, sm_get_boundary_faces, sm_get_quality, sm_num_nodes, sm_get_nodes, &
             sm_get_tets10, sm_num_regions, sm_get_regions, &
             sm_write_c, sm_write_binary_c, sm_last_error_c, &

@@ -521,6 +521,54 @@ sm_status sm_set_progress_cb(sm_mesher *m, sm_progress_fn f, void *user_data);
  */
 sm_status sm_refine(sm_mesher *m);
 
+#if defined(SLIVERMESH_MPI)
+/**
+ * Meshes the domain on every rank of the communicator `fortran_comm` (a Fortran handle: from
+ * C pass `MPI_Comm_c2f(comm)`, from Fortran the communicator itself). Collective: every rank
+ * of the communicator calls it with the same domain and settings; MPI must be initialized.
+ * The domain is cut into one part per rank, each rank refines and improves its part with the
+ * interfaces between parts as constraints, then the interfaces are moved and the zones along
+ * them improved again (docs/distributed.md). Afterwards `sm_num_vertices`, `sm_get_tets`,
+ * ... give this rank's part (local vertex ids from 0, its share of the boundary triangles),
+ * and `sm_get_global_vertex_ids` / `sm_global_counts` its global numbering: a vertex on an
+ * interface has one global id on every rank that holds it. The library communicates on a
+ * duplicate of the communicator, so it never mixes with the caller's messages. A failure on
+ * any rank fails the call on every rank (the others' `sm_last_error` names the failing rank).
+ * A spacing callback is called on every rank; `sm_write` writes this rank's part.
+ *
+ * # Safety
+ * `m` is NULL or a live handle; registered callbacks and their `user_data` are valid.
+ */
+sm_status sm_refine_mpi(sm_mesher *m, int32_t fortran_comm);
+#endif
+
+#if defined(SLIVERMESH_MPI)
+/**
+ * Copies the global id of each of this rank's vertices (in `sm_get_vertices`' order) into
+ * `ids`, which holds `capacity` values; after `sm_refine_mpi` only (`SM_ERR_NOT_REFINED`
+ * otherwise).
+ *
+ * # Safety
+ * `m` is NULL or a live handle; `ids` is NULL or points to `capacity` writable values.
+ */
+sm_status sm_get_global_vertex_ids(const sm_mesher *m, uint64_t *ids, size_t capacity);
+#endif
+
+#if defined(SLIVERMESH_MPI)
+/**
+ * The global counts of the last `sm_refine_mpi` (vertices and tets over all ranks, each
+ * once) and the global id of this rank's first tet (its tets follow in `sm_get_tets`' order).
+ * Any pointer may be NULL (that value is not written).
+ *
+ * # Safety
+ * `m` is NULL or a live handle; each pointer is NULL or writable.
+ */
+sm_status sm_global_counts(const sm_mesher *m,
+                           uint64_t *n_vertices,
+                           uint64_t *n_tets,
+                           uint64_t *first_tet);
+#endif
+
 /**
  * Number of mesh vertices (input vertices first, in input order); 0 before a successful
  * `sm_refine` or for a NULL or poisoned handle.

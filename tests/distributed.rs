@@ -317,3 +317,56 @@ fn fandisk_approximate_on_three_ranks() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The C ABI's `sm_refine_mpi` from inside a C MPI program (ctests/ffi/test_refine_mpi.c,
+/// built with mpicc against the static library beside the binary) on 2 and 3 ranks: the
+/// program checks the global numbers and the parts' quality itself.
+#[test]
+fn c_abi_refine_mpi_on_two_and_three_ranks() {
+    if !has_mpirun() {
+        println!("skipped: mpirun is not on PATH");
+        return;
+    }
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let lib = Path::new(BIN).with_file_name("libslivermesh.a");
+    if !lib.exists() {
+        // scripts/test-all builds it (`cargo build --features mpi`).
+        println!("skipped: {} is not built", lib.display());
+        return;
+    }
+    let exe = scratch("c-abi").join("test_refine_mpi");
+    std::fs::create_dir_all(exe.parent().unwrap()).unwrap();
+    let built = Command::new("mpicc")
+        .args(["-std=c99", "-Wall", "-Werror", "-O1"])
+        .arg(root.join("ctests/ffi/test_refine_mpi.c"))
+        .arg("-I")
+        .arg(root.join("include"))
+        .arg("-I")
+        .arg(root.join("ctests/ffi"))
+        .arg(&lib)
+        .args(["-lpthread", "-ldl", "-lm", "-o"])
+        .arg(&exe)
+        .output()
+        .expect("mpicc (Debian: libopenmpi-dev)");
+    assert!(
+        built.status.success(),
+        "mpicc failed:\n{}",
+        String::from_utf8_lossy(&built.stderr)
+    );
+    for np in ["2", "3"] {
+        let out = Command::new("mpirun")
+            .args(["--oversubscribe", "--allow-run-as-root", "-np", np])
+            .arg(&exe)
+            .output()
+            .unwrap();
+        let text = format!(
+            "{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        println!("{text}");
+        assert!(out.status.success(), "{np} ranks:\n{text}");
+        assert!(text.contains("all checks passed"), "{text}");
+    }
+    let _ = std::fs::remove_dir_all(exe.parent().unwrap());
+}

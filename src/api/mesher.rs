@@ -496,9 +496,10 @@ impl Mesher {
             .write_in(path, binary)
     }
 
-    /// Installs a result without meshing (tests of the output paths).
-    #[cfg(test)]
-    pub(crate) fn set_output_for_test(&mut self, mesh: TetMesh, report: Report) {
+    /// Installs a result meshed elsewhere (a distributed run's part, the tests of the output
+    /// paths).
+    #[cfg(any(test, feature = "mpi"))]
+    pub(crate) fn install_output(&mut self, mesh: TetMesh, report: Report) {
         self.output = Some(MeshOutput {
             mesh,
             quadratic: None,

@@ -108,7 +108,7 @@ fn outputs_need_a_current_refine() {
         m.write("never.vtu".as_ref()).unwrap_err(),
         Error::NotRefined
     );
-    m.set_output_for_test(TetMesh::default(), Report::default());
+    m.install_output(TetMesh::default(), Report::default());
     assert!(m.mesh().is_ok());
     m.set_param("seed", 3.0).unwrap();
     assert!(m.output().is_none(), "a setter must discard the result");

@@ -13,6 +13,7 @@ const HEADER_SOURCES: &[&str] = &[
     "input.rs",
     "settings.rs",
     "run.rs",
+    "mpi.rs",
     "output.rs",
     "quality.rs",
 ];

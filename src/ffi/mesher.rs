@@ -31,6 +31,9 @@ pub(crate) struct State {
     pub progress_cb: Option<CProgress>,
     /// `Report::stop_reason` of the last successful refine, for `sm_stop_reason`.
     pub stop_reason: Option<CString>,
+    /// This rank's global numbers after `sm_refine_mpi`.
+    #[cfg(feature = "mpi")]
+    pub part_ids: Option<super::mpi::PartIds>,
 }
 
 impl sm_mesher {

@@ -10,6 +10,8 @@
 //! - `input`: `sm_add_*` (the domain);
 //! - `settings`: `sm_set_param`, `sm_get_param`, `sm_set_spacing_*`, `sm_set_progress_cb`;
 //! - `run`: `sm_refine`;
+//! - `mpi` (cargo feature `mpi`): `sm_refine_mpi`, `sm_get_global_vertex_ids`,
+//!   `sm_global_counts`;
 //! - `quality`: the `sm_quality` struct and `sm_get_quality`;
 //! - `output`: `sm_num_*`, `sm_get_*` (copies into caller buffers), `sm_write`, `sm_stop_reason`.
 //!
@@ -30,6 +32,8 @@ mod callbacks;
 mod guard;
 mod input;
 mod mesher;
+#[cfg(feature = "mpi")]
+mod mpi;
 mod output;
 mod quality;
 mod run;
@@ -40,6 +44,8 @@ mod status;
 pub use callbacks::{sm_progress_fn, sm_spacing_batch_fn, sm_spacing_fn};
 pub use input::*;
 pub use mesher::*;
+#[cfg(feature = "mpi")]
+pub use mpi::*;
 pub use output::*;
 pub use quality::*;
 pub use run::*;

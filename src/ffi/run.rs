@@ -30,6 +30,10 @@ pub unsafe extern "C" fn sm_refine(m: *mut sm_mesher) -> sm_status {
     let handle = unsafe { m.as_ref() };
     handle_call(handle, "sm_refine", |st| {
         st.stop_reason = None;
+        #[cfg(feature = "mpi")]
+        {
+            st.part_ids = None;
+        }
         // A callback declared thread-safe has its big batches split across the run's threads;
         // any other is called only from this thread (`CSpacing` is not `Sync`).
         let shared = st

@@ -81,7 +81,7 @@ fn inject(h: &Handle) {
         .state
         .borrow_mut()
         .mesher
-        .set_output_for_test(mesh, report);
+        .install_output(mesh, report);
 }
 
 #[test]

@@ -96,7 +96,8 @@ impl Domain {
                     return Ok(Settled::BudgetSpent);
                 }
                 let Some(p) = self.split_point_clear_of_frozen(a, b) else {
-                    frozen_missing(status, &format!("subsegment ({a}, {b})"))?;
+                    let (pa, pb) = (self.point(a), self.point(b));
+                    frozen_missing(status, &format!("subsegment ({a}, {b}) from {pa} to {pb}"))?;
                     continue;
                 };
                 self.split_subsegment(a, b, p, None)?;
