@@ -183,7 +183,12 @@ fn check_distributed(np: usize, name: &str, size: &str) {
             r["max_dihedral_deg"].as_f64(),
         );
         assert!(lo.unwrap() > 0.0 && hi.unwrap() < 180.0, "{r}");
+        assert!(
+            r["min_dihedral_before_move_deg"].as_f64().unwrap() > 0.0,
+            "{r}"
+        );
     }
+    assert_eq!(json["interface_passes"].as_u64(), Some(1));
     assert_eq!(
         json["global_vertices"].as_u64(),
         Some(mesh.vertices.len() as u64)

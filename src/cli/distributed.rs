@@ -102,6 +102,7 @@ fn run<C: mpi::traits::Communicator>(
         peak_rss_mb: super::rss::peak_rss_bytes().map_or(0.0, |b| b as f64 / 1e6),
         min_dihedral_deg: part.report.dihedral_range()[0],
         max_dihedral_deg: part.report.dihedral_range()[1],
+        min_dihedral_before_move_deg: part.min_dihedral_before_move_deg,
     };
     let Some(ranks) = distributed::gather_stats(comm, stats)? else {
         return Ok(());
@@ -115,6 +116,7 @@ fn run<C: mpi::traits::Communicator>(
         ("global_tets", n.n_tets.into()),
         ("global_min_dihedral_deg", min_dihedral.into()),
         ("global_max_dihedral_deg", max_dihedral.into()),
+        ("interface_passes", distributed::INTERFACE_PASSES.into()),
     ];
     println!("{}", ranks_table(&ranks, n.n_vertices, n.n_tets));
     match (whole, out) {
@@ -170,8 +172,11 @@ fn ranks_table(ranks: &[RankStats], vertices: u64, tets: u64) -> String {
         ));
     }
     let (lo, hi) = global_dihedral_range(ranks);
+    let before = (ranks.iter()).fold(f64::MAX, |m, s| m.min(s.min_dihedral_before_move_deg));
     out.push_str(&format!(
-        "  all ranks: dihedral min / max {lo:.2} / {hi:.2}; the report below is rank 0's part\n"
+        "  all ranks: dihedral min / max {lo:.2} / {hi:.2} (min {before:.2} before the interfaces \
+         moved, {} pass); the report below is rank 0's part\n",
+        distributed::INTERFACE_PASSES
     ));
     out
 }

@@ -75,10 +75,15 @@ pub struct Part {
     /// This rank's part: local vertex ids from 0, its tets and regions, the domain boundary
     /// triangles that are faces of its tets.
     pub mesh: TetMesh,
-    /// The part's report (`partition::mesh_part`).
+    /// The part's report (`partition::mesh_part`, measured again after the interfaces moved).
     pub report: Report,
+    /// The smallest dihedral angle of the part before its interfaces moved, degrees.
+    pub min_dihedral_before_move_deg: f64,
     pub numbering: Numbering,
 }
+
+/// How many times the interfaces are moved (`partition::move_interfaces`).
+pub const INTERFACE_PASSES: u32 = 1;
 
 /// Meshes `input` on all ranks of `comm` (collective): plans the partition into one part per
 /// rank, meshes this rank's part and numbers it globally.
@@ -98,6 +103,7 @@ pub fn mesh_on<C: Communicator>(
         .map_err(|e| Error::here(format!("rank {rank}: {e}")));
     let (part, part_params) = collect::agree(comm, meshed)?;
     let mut report = part.report;
+    let min_dihedral_before_move_deg = report.dihedral_range()[0];
     let mesh = move_interfaces(comm, &part.mesh, &part.interface, &part_params)?;
     crate::partition::measure_part(&mut report, &mesh);
     let numbering = numbering::number(comm, &mesh)?;
@@ -106,6 +112,7 @@ pub fn mesh_on<C: Communicator>(
         size,
         mesh,
         report,
+        min_dihedral_before_move_deg,
         numbering,
     })
 }
@@ -142,6 +149,8 @@ pub struct RankStats {
     /// The smallest and largest dihedral angles of the rank's tets, in degrees.
     pub min_dihedral_deg: f64,
     pub max_dihedral_deg: f64,
+    /// The smallest dihedral angle of the rank's part before the interfaces moved.
+    pub min_dihedral_before_move_deg: f64,
 }
 
 /// Every rank's `stats` on rank 0, in rank order (`None` on the other ranks; collective).
@@ -155,6 +164,7 @@ pub fn gather_stats<C: Communicator>(
         stats.peak_rss_mb,
         stats.min_dihedral_deg,
         stats.max_dihedral_deg,
+        stats.min_dihedral_before_move_deg,
     ];
     let rows = collect::gather_varcount(comm, &row[..], "statistics")?;
     Ok(rows.map(|(rows, _)| {
@@ -165,6 +175,7 @@ pub fn gather_stats<C: Communicator>(
                 peak_rss_mb: r[2],
                 min_dihedral_deg: r[3],
                 max_dihedral_deg: r[4],
+                min_dihedral_before_move_deg: r[5],
             })
             .collect()
     }))
