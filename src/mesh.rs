@@ -27,20 +27,33 @@ impl TetMesh {
         faces.reserve(2 * self.tets.len());
         for t in &self.tets {
             for skip in 0..4 {
-                let mut f = [0; 3];
-                let mut k = 0;
-                for (i, &v) in t.iter().enumerate() {
-                    if i != skip {
-                        f[k] = v;
-                        k += 1;
-                    }
-                }
+                let mut f = tet_face(t, skip);
                 f.sort_unstable();
                 *faces.entry(f).or_insert(0) += 1;
             }
         }
         faces
     }
+
+    /// Removes the boundary triangles with marker `marker` (a run's working marks).
+    pub fn remove_boundary_marker(&mut self, marker: i32) {
+        let mut kept = self.boundary_markers.iter().map(|&m| m != marker);
+        self.boundary.retain(|_| kept.next().unwrap_or(true));
+        self.boundary_markers.retain(|&m| m != marker);
+    }
+}
+
+/// The face of tet `t` opposite its vertex `skip` (the other three in order).
+pub fn tet_face(t: &[u32; 4], skip: usize) -> [u32; 3] {
+    let mut f = [0; 3];
+    let mut k = 0;
+    for (i, &v) in t.iter().enumerate() {
+        if i != skip {
+            f[k] = v;
+            k += 1;
+        }
+    }
+    f
 }
 
 /// The mid-edge nodes that make a [`TetMesh`] a mesh of ten-node (quadratic) tets.

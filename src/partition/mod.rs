@@ -189,12 +189,7 @@ pub fn mesh_part(plan: &Plan, part: usize) -> Result<MeshedPart, MeshError> {
         .filter(|b| frozen_corners.contains(&corner_key(&b[..], &mesh.vertices)))
         .copied()
         .collect();
-    let keep: Vec<bool> = (mesh.boundary_markers.iter())
-        .map(|&m| m != INTERFACE_MARKER)
-        .collect();
-    let mut k = keep.iter();
-    mesh.boundary.retain(|_| *k.next().unwrap_or(&true));
-    mesh.boundary_markers.retain(|&m| m != INTERFACE_MARKER);
+    mesh.remove_boundary_marker(INTERFACE_MARKER);
     Ok(MeshedPart {
         mesh,
         report,

@@ -11,7 +11,7 @@
 //! every piece has one owner and the result is the same whichever rank computes it.
 
 use super::MeshedPart;
-use crate::mesh::TetMesh;
+use crate::mesh::{tet_face as face, TetMesh};
 use crate::run::error::MeshError;
 use crate::run::params::Params;
 use crate::run::report::ImproveStats;
@@ -33,18 +33,6 @@ pub struct Cut {
     pub rest: TetMesh,
     /// The tets within [`ZONE_LAYERS`] of them.
     pub zone: TetMesh,
-}
-
-fn face(t: &[u32; 4], skip: usize) -> [u32; 3] {
-    let mut f = [0; 3];
-    let mut k = 0;
-    for (i, &v) in t.iter().enumerate() {
-        if i != skip {
-            f[k] = v;
-            k += 1;
-        }
-    }
-    f
 }
 
 fn key(mut f: [u32; 3]) -> [u32; 3] {
@@ -249,12 +237,7 @@ pub fn improve_zone(zone: TetMesh, params: &Params) -> Result<(TetMesh, ImproveS
         ..Default::default()
     };
     let (mut mesh, stats) = crate::improve::finish(mesh, Some(&fixed), params, None)?;
-    let keep: Vec<bool> = (mesh.boundary_markers.iter())
-        .map(|&m| m != ZONE_MARKER)
-        .collect();
-    let mut k = keep.iter();
-    mesh.boundary.retain(|_| *k.next().unwrap_or(&true));
-    mesh.boundary_markers.retain(|&m| m != ZONE_MARKER);
+    mesh.remove_boundary_marker(ZONE_MARKER);
     Ok((mesh, stats))
 }
 
