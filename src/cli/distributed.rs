@@ -116,9 +116,12 @@ fn run<C: mpi::traits::Communicator>(
         ("global_tets", n.n_tets.into()),
         ("global_min_dihedral_deg", min_dihedral.into()),
         ("global_max_dihedral_deg", max_dihedral.into()),
-        ("interface_passes", distributed::INTERFACE_PASSES.into()),
+        ("interface_passes", part.interface_passes.into()),
     ];
-    println!("{}", ranks_table(&ranks, n.n_vertices, n.n_tets));
+    println!(
+        "{}",
+        ranks_table(&ranks, n.n_vertices, n.n_tets, part.interface_passes)
+    );
     match (whole, out) {
         (Some(mesh), out) => {
             let written = Written {
@@ -156,7 +159,7 @@ fn global_dihedral_range(ranks: &[RankStats]) -> (f64, f64) {
 
 /// Rank 0's table of the ranks: tets, seconds, peak memory, dihedral range, and the global
 /// counts and dihedral range (the report below it is rank 0's part's).
-fn ranks_table(ranks: &[RankStats], vertices: u64, tets: u64) -> String {
+fn ranks_table(ranks: &[RankStats], vertices: u64, tets: u64, passes: u32) -> String {
     let mut out = format!(
         "distributed run: {} ranks, {vertices} vertices, {tets} tets\n  rank {:>12} {:>10} {:>14} {:>16}\n",
         ranks.len(),
@@ -175,8 +178,8 @@ fn ranks_table(ranks: &[RankStats], vertices: u64, tets: u64) -> String {
     let before = (ranks.iter()).fold(f64::MAX, |m, s| m.min(s.min_dihedral_before_move_deg));
     out.push_str(&format!(
         "  all ranks: dihedral min / max {lo:.2} / {hi:.2} (min {before:.2} before the interfaces \
-         moved, {} pass); the report below is rank 0's part\n",
-        distributed::INTERFACE_PASSES
+         moved, {passes} pass{}); the report below is rank 0's part\n",
+        if passes == 1 { "" } else { "es" }
     ));
     out
 }

@@ -22,6 +22,13 @@ pub fn agree<C: Communicator, T>(comm: &C, local: Result<T, Error>) -> Result<T,
     }
 }
 
+/// The smallest of every rank's `x`, on every rank.
+pub fn all_min<C: Communicator>(comm: &C, x: f64) -> f64 {
+    let mut min = x;
+    comm.all_reduce_into(&x, &mut min, SystemOperation::min());
+    min
+}
+
 /// Every rank's `n`, on every rank.
 pub fn all_counts<C: Communicator>(comm: &C, n: usize) -> Vec<u64> {
     let mut all = vec![0u64; comm.size() as usize];

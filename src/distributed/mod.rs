@@ -79,6 +79,8 @@ pub struct Part {
     pub report: Report,
     /// The smallest dihedral angle of the part before its interfaces moved, degrees.
     pub min_dihedral_before_move_deg: f64,
+    /// How many times the interfaces were moved (the same on every rank).
+    pub interface_passes: u32,
     pub numbering: Numbering,
 }
 
@@ -97,14 +99,16 @@ pub fn mesh_on<C: Communicator>(
     let size = comm.size() as usize;
     let meshed = crate::partition::plan(input, params, spacing, size)
         .and_then(|plan| {
-            let part = crate::partition::mesh_part(&plan, rank)?;
-            Ok((part, plan.params().clone()))
+            let params = plan.params().clone();
+            // The coarse mesh and the band are dropped before the part is refined.
+            let part = plan.into_part(rank)?;
+            Ok((part.mesh()?, params))
         })
         .map_err(|e| Error::here(format!("rank {rank}: {e}")));
     let (part, part_params) = collect::agree(comm, meshed)?;
     let mut report = part.report;
     let min_dihedral_before_move_deg = report.dihedral_range()[0];
-    let mesh = move_interfaces(comm, &part.mesh, &part.interface, &part_params)?;
+    let (mesh, interface_passes) = move_interfaces(comm, part.mesh, part.interface, &part_params)?;
     crate::partition::measure_part(&mut report, &mesh);
     let numbering = numbering::number(comm, &mesh)?;
     Ok(Part {
@@ -113,29 +117,43 @@ pub fn mesh_on<C: Communicator>(
         mesh,
         report,
         min_dihedral_before_move_deg,
+        interface_passes,
         numbering,
     })
 }
 
-/// This rank's part with the interfaces moved (`partition::move_interfaces`, collective):
-/// every rank's zone around its interfaces goes to every rank, each improves the pieces it
-/// owns and keeps them with the rest of its part. (The zones are a few layers of tets along
-/// the interfaces; every rank holds all of them for now, see docs/distributed.md.)
+/// This rank's part with the interfaces moved (`partition::move_interfaces`, collective),
+/// and how many passes that took: every rank's zone around its interfaces and bad tets goes
+/// to every rank, each improves the pieces it owns and puts them back into its part; again
+/// while the worst tet of all ranks is below the improvement target and the last pass raised
+/// it. (The zones are a layer of tets along the interfaces; every rank holds all of them for
+/// now, see docs/distributed.md.)
 fn move_interfaces<C: Communicator>(
     comm: &C,
-    part: &TetMesh,
-    interface: &[[u32; 3]],
+    mut mesh: TetMesh,
+    mut interface: Vec<[u32; 3]>,
     params: &Params,
-) -> Result<TetMesh, Error> {
+) -> Result<(TetMesh, u32), Error> {
+    use crate::partition as p;
     let rank = comm.rank() as usize;
-    let cut = crate::partition::cut_zone(part, interface);
-    let zones = collect::all_gather_meshes(comm, &cut.zone)?;
-    let mine = crate::partition::share_zones(&zones).swap_remove(rank);
-    drop(zones);
-    let improved = crate::partition::improve_zone(mine, params)
-        .map_err(|e| Error::here(format!("rank {rank}, moving the interfaces: {e}")));
-    let (improved, _) = collect::agree(comm, improved)?;
-    Ok(crate::partition::glue(&[cut.rest, improved]).0)
+    let target = params.effective_improve_target();
+    let (worst, mut bad) = p::bad_tets(&mesh, target);
+    let mut worst = collect::all_min(comm, worst);
+    let (mut passes, mut before) = (0, worst);
+    while p::another_pass(passes, before, worst, target) {
+        let cut = p::cut_zone(mesh, &interface, &bad);
+        let zones = collect::all_gather_meshes(comm, &cut.zone)?;
+        let share = p::share_zones(&zones).swap_remove(rank);
+        drop(zones);
+        let improved = p::improve_zone(share.zone, params)
+            .map_err(|e| Error::here(format!("rank {rank}, moving the interfaces: {e}")));
+        let (improved, _) = collect::agree(comm, improved)?;
+        (mesh, interface) = p::rejoin(cut.rest, improved, &share.next_interface);
+        let (mine, b) = p::bad_tets(&mesh, target);
+        (passes, before, bad) = (passes + 1, worst, b);
+        worst = collect::all_min(comm, mine);
+    }
+    Ok((mesh, passes))
 }
 
 /// What rank 0 reports of each rank.

@@ -33,7 +33,10 @@ use crate::run::spacing::Spacing;
 use band::Band;
 use coarse::Coarse;
 use rustc_hash::FxHashSet;
-pub use zone::{cut_zone, glue, improve_zone, move_interfaces, share_zones, Cut, ZONE_LAYERS};
+pub use zone::{
+    another_pass, bad_tets, corners, cut_zone, glue, improve_zone, move_interfaces, rejoin,
+    share_zones, Corners, Cut, Share, MAX_INTERFACE_PASSES, ZONE_LAYERS,
+};
 
 /// One part as [`mesh_part`] gives it.
 pub struct MeshedPart {
@@ -141,30 +144,69 @@ pub fn plan<'s>(
     })
 }
 
+/// What meshing one part needs once its PLC is built: [`Plan::into_part`] gives it without
+/// the coarse mesh and the band, so a rank does not hold them while it refines.
+pub struct PartPlan<'s> {
+    params: Params,
+    spacing: PartSpacing<'s>,
+    plc: part_plc::PartPlc,
+}
+
+impl<'s> Plan<'s> {
+    /// Part `part`'s share of the plan, the rest of the plan dropped.
+    pub fn into_part(self, part: usize) -> Result<PartPlan<'s>, MeshError> {
+        let plc = self.part_plc(part)?;
+        Ok(PartPlan {
+            params: self.params,
+            spacing: self.spacing,
+            plc,
+        })
+    }
+
+    fn part_plc(&self, part: usize) -> Result<part_plc::PartPlc, MeshError> {
+        if part >= self.parts() {
+            return Err(MeshError::InvalidInput(format!(
+                "part {part} of a plan of {} parts",
+                self.parts()
+            )));
+        }
+        part_plc::build(&self.coarse, &self.band, part)
+    }
+}
+
+impl PartPlan<'_> {
+    /// Meshes the part (as [`mesh_part`]).
+    pub fn mesh(self) -> Result<MeshedPart, MeshError> {
+        mesh_plc(self.plc, &self.params, self.spacing.get())
+    }
+}
+
 /// Meshes part `part` of `plan`: its tets, vertices numbered from 0, region attributes, and
 /// the domain's boundary and region-interface triangles (with markers) that are faces of its
 /// tets; the interface triangles it shares with other parts are the band's. The report's
 /// region figures are left to [`measure_part`], once the interfaces have moved.
 pub fn mesh_part(plan: &Plan, part: usize) -> Result<MeshedPart, MeshError> {
-    if part >= plan.parts() {
-        return Err(MeshError::InvalidInput(format!(
-            "part {part} of a plan of {} parts",
-            plan.parts()
-        )));
-    }
+    mesh_plc(plan.part_plc(part)?, &plan.params, plan.spacing.get())
+}
+
+fn mesh_plc(
+    plc: part_plc::PartPlc,
+    params: &Params,
+    spacing: &dyn Spacing,
+) -> Result<MeshedPart, MeshError> {
     let part_plc::PartPlc {
         input,
         frozen,
         on_facets,
-    } = part_plc::build(&plan.coarse, &plan.band, part)?;
+    } = plc;
     let refine_params = Params {
         improve: false,
-        ..plan.params.clone()
+        ..params.clone()
     };
     let (mesh, mut report) = crate::refine::mesh_frozen(
         &input,
         &refine_params,
-        Some(plan.spacing.get()),
+        Some(spacing),
         &frozen,
         crate::refine::Unseeded::Hole,
     )?;
@@ -176,17 +218,17 @@ pub fn mesh_part(plan: &Plan, part: usize) -> Result<MeshedPart, MeshError> {
         vertices: input.vertices[..on_facets].to_vec(),
         ..input
     };
-    let frozen_corners: FxHashSet<[[u64; 3]; 3]> = (frozen.iter())
+    let frozen_corners: FxHashSet<Corners> = (frozen.iter())
         .map(|&f| {
-            corner_key(
+            zone::corners(
                 &facets_only.facets[f as usize].polygons[0],
                 &facets_only.vertices,
             )
         })
         .collect();
-    let mut mesh = crate::pipeline::improve(mesh, &mut report, Some(&facets_only), &plan.params)?;
+    let mut mesh = crate::pipeline::improve(mesh, &mut report, Some(&facets_only), params)?;
     let interface: Vec<[u32; 3]> = (mesh.boundary.iter())
-        .filter(|b| frozen_corners.contains(&corner_key(&b[..], &mesh.vertices)))
+        .filter(|b| frozen_corners.contains(&zone::corners(&b[..], &mesh.vertices)))
         .copied()
         .collect();
     mesh.remove_boundary_marker(INTERFACE_MARKER);
@@ -195,13 +237,6 @@ pub fn mesh_part(plan: &Plan, part: usize) -> Result<MeshedPart, MeshError> {
         report,
         interface,
     })
-}
-
-/// A triangle's corners' coordinate bits, sorted (the frozen triangles keep their corners).
-fn corner_key(tri: &[u32], vertices: &[glam::DVec3]) -> [[u64; 3]; 3] {
-    let mut k = [0, 1, 2].map(|i| vertices[tri[i] as usize].to_array().map(f64::to_bits));
-    k.sort_unstable();
-    k
 }
 
 /// The report's shape and region figures for the part's final mesh.

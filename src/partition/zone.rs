@@ -2,10 +2,12 @@
 //! frozen interface triangles: refinement refuses the points that would encroach them, and
 //! the improver may not move their vertices nor flip them. So after every part is meshed, the
 //! zone around each interface (the tets of both parts within [`ZONE_LAYERS`] vertex layers of
-//! it) is cut out of the parts, glued, and improved again with the old interface free inside
-//! it and the zone's outer faces fixed: those are faces of the parts' tets away from the
-//! interface, which met the serial run's bounds. In effect the interface moves to the zone's
-//! outer faces, where the mesh is already good.
+//! it, and of the tets below the improvement target) is cut out of the parts, glued, and
+//! improved again with the old interface free inside it and the zone's outer faces fixed:
+//! those are faces of the parts' tets away from the interface, which met the serial run's
+//! bounds. In effect the interface moves to the zone's outer faces, where the mesh is already
+//! good; [`share_zones`] says which of them are the parts' new interfaces, and the next pass
+//! starts from those ([`another_pass`] says whether one is due).
 //!
 //! Each connected piece of the glued zone goes to the lowest part among its tets' parts, so
 //! every piece has one owner and the result is the same whichever rank computes it.
@@ -16,6 +18,7 @@ use crate::run::error::MeshError;
 use crate::run::params::Params;
 use crate::run::report::ImproveStats;
 use crate::union_find::UnionFind;
+use glam::DVec3;
 use rustc_hash::{FxHashMap, FxHashSet};
 
 /// Vertex layers of tets on each side of an interface that are improved again: one, the tets
@@ -29,7 +32,7 @@ const ZONE_MARKER: i32 = i32::MIN + 2;
 
 /// A part's mesh cut in two.
 pub struct Cut {
-    /// The tets away from the part's interfaces.
+    /// The tets away from the part's interfaces and bad tets.
     pub rest: TetMesh,
     /// The tets within [`ZONE_LAYERS`] of them.
     pub zone: TetMesh,
@@ -38,6 +41,28 @@ pub struct Cut {
 fn key(mut f: [u32; 3]) -> [u32; 3] {
     f.sort_unstable();
     f
+}
+
+/// A triangle by its corners' exact coordinates, sorted: how the parts name the interface
+/// triangles they share (their vertex ids differ).
+pub type Corners = [[u64; 3]; 3];
+
+/// Triangle `tri`'s [`Corners`].
+pub fn corners(tri: &[u32], vertices: &[DVec3]) -> Corners {
+    let mut k = [0, 1, 2].map(|i| vertices[tri[i] as usize].to_array().map(f64::to_bits));
+    k.sort_unstable();
+    k
+}
+
+/// The smallest dihedral angle of `mesh` (degrees; `f64::MAX` for no tet), and which of its
+/// tets are below `target_deg`.
+pub fn bad_tets(mesh: &TetMesh, target_deg: f64) -> (f64, Vec<bool>) {
+    let angles: Vec<f64> = crate::parallel::map_collect(&mesh.tets, |t| {
+        let p = t.map(|v| mesh.vertices[v as usize]);
+        crate::geom::measures::min_max_dihedral(p[0], p[1], p[2], p[3]).0
+    });
+    let worst = angles.iter().copied().fold(f64::MAX, f64::min);
+    (worst, angles.iter().map(|&a| a < target_deg).collect())
 }
 
 /// The faces of one tet of `mesh` that are not boundary triangles, each as its tet's face.
@@ -58,8 +83,9 @@ fn open_faces(mesh: &TetMesh) -> Vec<[u32; 3]> {
 }
 
 /// The tets of `mesh` where `keep` is true, with the vertices they use (numbered from 0 in
-/// order) and the boundary triangles that are faces of them.
-fn sub_mesh(mesh: &TetMesh, keep: &[bool]) -> TetMesh {
+/// order) and the boundary triangles that are faces of them; and which of `mesh`'s boundary
+/// triangles those are.
+fn sub_mesh(mesh: &TetMesh, keep: &[bool]) -> (TetMesh, Vec<bool>) {
     let boundary_index: FxHashMap<[u32; 3], u32> = (mesh.boundary.iter().enumerate())
         .map(|(i, &b)| (key(b), i as u32))
         .collect();
@@ -94,15 +120,19 @@ fn sub_mesh(mesh: &TetMesh, keep: &[bool]) -> TetMesh {
         out.boundary.push(b.map(|v| id[v as usize]));
         out.boundary_markers.push(m);
     }
-    out
+    (out, boundary_kept)
 }
 
-/// Cuts a part's mesh into its zone and the rest; `interface` holds its triangles on its
-/// interfaces (`MeshedPart::interface`).
-pub fn cut_zone(part: &TetMesh, interface: &[[u32; 3]]) -> Cut {
+/// Cuts a part's mesh into its zone and the rest. The zone grows from the part's triangles
+/// on its interfaces (`interface`, vertex ids of `part`) and from its tets where `bad` is
+/// true. The rest is `part` itself with the zone's tets taken out (no copy of the part).
+pub fn cut_zone(part: TetMesh, interface: &[[u32; 3]], bad: &[bool]) -> Cut {
     let mut near = vec![false; part.vertices.len()];
     for f in interface {
         f.iter().for_each(|&v| near[v as usize] = true);
+    }
+    for (tv, _) in part.tets.iter().zip(bad).filter(|(_, &b)| b) {
+        tv.iter().for_each(|&v| near[v as usize] = true);
     }
     let mut in_zone = vec![false; part.tets.len()];
     for _ in 0..ZONE_LAYERS {
@@ -115,11 +145,79 @@ pub fn cut_zone(part: &TetMesh, interface: &[[u32; 3]]) -> Cut {
             }
         }
     }
-    let away: Vec<bool> = in_zone.iter().map(|&z| !z).collect();
-    Cut {
-        rest: sub_mesh(part, &away),
-        zone: sub_mesh(part, &in_zone),
+    let (zone, zone_boundary) = sub_mesh(&part, &in_zone);
+    let rest = without_tets(part, &in_zone, &zone_boundary);
+    Cut { rest, zone }
+}
+
+/// `mesh` without the tets where `drop` is true, in place: the vertices no tet uses any more
+/// and the boundary triangles that are no face of a kept tet are left out. `touched` tells
+/// which boundary triangles are faces of dropped tets (the others are faces of kept ones).
+fn without_tets(mut mesh: TetMesh, drop: &[bool], touched: &[bool]) -> TetMesh {
+    // A touched triangle stays where it is also a kept tet's face (a region interface with
+    // the zone on one side): only kept tets with three vertices on dropped tets can have it.
+    let mut on_dropped = vec![false; mesh.vertices.len()];
+    for (tv, _) in mesh.tets.iter().zip(drop).filter(|(_, &d)| d) {
+        tv.iter().for_each(|&v| on_dropped[v as usize] = true);
     }
+    let touched_keys: FxHashSet<[u32; 3]> = (mesh.boundary.iter().zip(touched))
+        .filter(|(_, &t)| t)
+        .map(|(&b, _)| key(b))
+        .collect();
+    let mut also_kept: FxHashSet<[u32; 3]> = FxHashSet::default();
+    for (tv, _) in mesh.tets.iter().zip(drop).filter(|(_, &d)| !d) {
+        if tv.iter().filter(|&&v| on_dropped[v as usize]).count() >= 3 {
+            for skip in 0..4 {
+                let k = key(face(tv, skip));
+                if touched_keys.contains(&k) {
+                    also_kept.insert(k);
+                }
+            }
+        }
+    }
+    let mut t = 0;
+    mesh.tets.retain(|_| {
+        t += 1;
+        !drop[t - 1]
+    });
+    let mut t = 0;
+    mesh.tet_regions.retain(|_| {
+        t += 1;
+        !drop[t - 1]
+    });
+    let keep_boundary: Vec<bool> = (mesh.boundary.iter().zip(touched))
+        .map(|(&b, &t)| !t || also_kept.contains(&key(b)))
+        .collect();
+    let mut i = 0;
+    mesh.boundary.retain(|_| {
+        i += 1;
+        keep_boundary[i - 1]
+    });
+    let mut i = 0;
+    mesh.boundary_markers.retain(|_| {
+        i += 1;
+        keep_boundary[i - 1]
+    });
+    // Vertices renumbered in order, the unused ones left out.
+    let mut id = vec![u32::MAX; mesh.vertices.len()];
+    mesh.tets.iter().flatten().for_each(|&v| id[v as usize] = 0);
+    let mut n = 0;
+    for (v, new) in id.iter_mut().enumerate() {
+        if *new == 0 {
+            *new = n;
+            mesh.vertices[n as usize] = mesh.vertices[v];
+            n += 1;
+        }
+    }
+    mesh.vertices.truncate(n as usize);
+    mesh.vertices.shrink_to_fit();
+    for tv in mesh.tets.iter_mut() {
+        *tv = tv.map(|v| id[v as usize]);
+    }
+    for b in mesh.boundary.iter_mut() {
+        *b = b.map(|v| id[v as usize]);
+    }
+    mesh
 }
 
 /// `meshes` glued into one by their vertices' exact coordinates (vertices no tet uses are
@@ -164,19 +262,33 @@ pub fn glue(meshes: &[TetMesh]) -> (TetMesh, Vec<u32>) {
     (out, source)
 }
 
+/// What one part gets of the glued zones.
+pub struct Share {
+    /// The pieces it improves.
+    pub zone: TetMesh,
+    /// Its triangles on the interfaces once the pieces are back in the parts: the pieces'
+    /// outer faces between the piece's owner and the part whose rest is on their other side,
+    /// where those differ.
+    pub next_interface: Vec<Corners>,
+}
+
 /// The zones of all parts (`zones[p]` is part p's) glued and cut into connected pieces
 /// (through faces), each given to the lowest part among its tets' parts: what each part
-/// improves, one mesh per part (empty where a part owns no piece).
-pub fn share_zones(zones: &[TetMesh]) -> Vec<TetMesh> {
+/// improves and its interfaces afterwards (empty where a part owns no piece).
+pub fn share_zones(zones: &[TetMesh]) -> Vec<Share> {
     let (zone, source) = glue(zones);
     let mut pieces = UnionFind::new(zone.tets.len());
-    let mut first: FxHashMap<[u32; 3], u32> = FxHashMap::default();
+    // Each face: its first tet, and whether a second one has it.
+    let mut faces: FxHashMap<[u32; 3], (u32, bool)> = FxHashMap::default();
     for (t, tv) in zone.tets.iter().enumerate() {
         for skip in 0..4 {
-            match first.entry(key(face(tv, skip))) {
-                std::collections::hash_map::Entry::Occupied(o) => pieces.union(*o.get(), t as u32),
+            match faces.entry(key(face(tv, skip))) {
+                std::collections::hash_map::Entry::Occupied(mut o) => {
+                    pieces.union(o.get().0, t as u32);
+                    o.get_mut().1 = true;
+                }
                 std::collections::hash_map::Entry::Vacant(v) => {
-                    v.insert(t as u32);
+                    v.insert((t as u32, false));
                 }
             }
         }
@@ -189,10 +301,31 @@ pub fn share_zones(zones: &[TetMesh]) -> Vec<TetMesh> {
     let owner: Vec<u32> = (0..zone.tets.len())
         .map(|t| owner[pieces.find(t as u32) as usize])
         .collect();
+    // An outer face (one tet, no boundary triangle) is a cut face of its tet's source part,
+    // whose rest is on its other side.
+    let boundary: FxHashSet<[u32; 3]> = zone.boundary.iter().map(|&b| key(b)).collect();
+    let mut next_interface = vec![vec![]; zones.len()];
+    let mut outer: Vec<(&[u32; 3], u32)> = (faces.iter())
+        .filter(|(k, &(_, twice))| !twice && !boundary.contains(*k))
+        .map(|(k, &(t, _))| (k, t))
+        .collect();
+    outer.sort_unstable();
+    for (f, t) in outer {
+        let (o, s) = (owner[t as usize], source[t as usize]);
+        if o != s {
+            let c = corners(f, &zone.vertices);
+            next_interface[o as usize].push(c);
+            next_interface[s as usize].push(c);
+        }
+    }
     (0..zones.len() as u32)
-        .map(|p| {
+        .zip(next_interface)
+        .map(|(p, next_interface)| {
             let mine: Vec<bool> = owner.iter().map(|&o| o == p).collect();
-            sub_mesh(&zone, &mine)
+            Share {
+                zone: sub_mesh(&zone, &mine).0,
+                next_interface,
+            }
         })
         .collect()
 }
@@ -241,19 +374,103 @@ pub fn improve_zone(zone: TetMesh, params: &Params) -> Result<(TetMesh, ImproveS
     Ok((mesh, stats))
 }
 
-/// The parts with their interfaces moved, in one process (`crate::distributed` does the
-/// same with the zones exchanged between ranks): each part's zone cut out, the zones shared
-/// out, improved, and glued to the rests.
-pub fn move_interfaces(parts: &[MeshedPart], params: &Params) -> Result<Vec<TetMesh>, MeshError> {
-    let cuts: Vec<Cut> = (parts.iter())
-        .map(|p| cut_zone(&p.mesh, &p.interface))
+/// `improved` (a part's pieces of the zones) put back into `rest` (the part without its
+/// zone), glued by the coordinates of their shared vertices, and the part's triangles on its
+/// new interfaces (`next`, from [`share_zones`]) as vertex ids of the result.
+pub fn rejoin(mut rest: TetMesh, improved: TetMesh, next: &[Corners]) -> (TetMesh, Vec<[u32; 3]>) {
+    let bits = |p: DVec3| p.to_array().map(f64::to_bits);
+    let index: FxHashMap<[u64; 3], u32> = (improved.vertices.iter().enumerate())
+        .map(|(i, &p)| (bits(p), i as u32))
         .collect();
-    let zones: Vec<TetMesh> = cuts.iter().map(|c| c.zone.clone()).collect();
-    let shares = share_zones(&zones);
-    let mut out = vec![];
-    for (cut, share) in cuts.into_iter().zip(shares) {
-        let (improved, _) = improve_zone(share, params)?;
-        out.push(glue(&[cut.rest, improved]).0);
+    let mut id = vec![u32::MAX; improved.vertices.len()];
+    let mut shared = vec![false; rest.vertices.len()];
+    for (v, &p) in rest.vertices.iter().enumerate() {
+        if let Some(&i) = index.get(&bits(p)) {
+            id[i as usize] = v as u32;
+            shared[v] = true;
+        }
     }
-    Ok(out)
+    for (i, &p) in improved.vertices.iter().enumerate() {
+        if id[i] == u32::MAX {
+            id[i] = rest.vertices.len() as u32;
+            rest.vertices.push(p);
+        }
+    }
+    let old = |v: u32| (v as usize) < shared.len() && shared[v as usize];
+    let rest_boundary: FxHashSet<[u32; 3]> = (rest.boundary.iter())
+        .filter(|b| b.iter().all(|&v| shared[v as usize]))
+        .map(|&b| key(b))
+        .collect();
+    rest.tets
+        .extend(improved.tets.iter().map(|t| t.map(|v| id[v as usize])));
+    rest.tet_regions.extend(&improved.tet_regions);
+    for (b, &m) in improved.boundary.iter().zip(&improved.boundary_markers) {
+        let b = b.map(|v| id[v as usize]);
+        // A region interface between the rest and the piece is in both.
+        if b.iter().all(|&v| old(v)) && rest_boundary.contains(&key(b)) {
+            continue;
+        }
+        rest.boundary.push(b);
+        rest.boundary_markers.push(m);
+    }
+    let wanted: FxHashSet<[u64; 3]> = next.iter().flatten().copied().collect();
+    let found: FxHashMap<[u64; 3], u32> = (rest.vertices.iter().enumerate())
+        .filter(|(_, &p)| wanted.contains(&bits(p)))
+        .map(|(v, &p)| (bits(p), v as u32))
+        .collect();
+    let interface = (next.iter())
+        .filter_map(|c| Some([found.get(&c[0])?, found.get(&c[1])?, found.get(&c[2])?].map(|&v| v)))
+        .collect();
+    (rest, interface)
+}
+
+/// The most times the interfaces are moved.
+pub const MAX_INTERFACE_PASSES: u32 = 3;
+
+/// Whether the interfaces move (again) after `passes` passes: the worst tet of all parts
+/// (`worst`, degrees) is below `target_deg`, and the last pass raised it (from
+/// `worst_before_last`).
+pub fn another_pass(passes: u32, worst_before_last: f64, worst: f64, target_deg: f64) -> bool {
+    passes < MAX_INTERFACE_PASSES
+        && worst < target_deg
+        && (passes == 0 || worst > worst_before_last)
+}
+
+/// The parts with their interfaces moved, in one process (`crate::distributed` does the
+/// same with the zones exchanged between ranks), and how many passes that took.
+pub fn move_interfaces(
+    parts: Vec<MeshedPart>,
+    params: &Params,
+) -> Result<(Vec<TetMesh>, u32), MeshError> {
+    let target = params.effective_improve_target();
+    let mut parts: Vec<(TetMesh, Vec<[u32; 3]>)> =
+        parts.into_iter().map(|p| (p.mesh, p.interface)).collect();
+    let mut bad: Vec<Vec<bool>> = vec![];
+    let mut worst = f64::MAX;
+    for (mesh, _) in &parts {
+        let (w, b) = bad_tets(mesh, target);
+        worst = worst.min(w);
+        bad.push(b);
+    }
+    let (mut passes, mut before) = (0, worst);
+    while another_pass(passes, before, worst, target) {
+        let cuts: Vec<Cut> = (parts.into_iter().zip(&bad))
+            .map(|((mesh, interface), bad)| cut_zone(mesh, &interface, bad))
+            .collect();
+        let zones: Vec<TetMesh> = cuts.iter().map(|c| c.zone.clone()).collect();
+        let shares = share_zones(&zones);
+        parts = vec![];
+        for (cut, share) in cuts.into_iter().zip(shares) {
+            let (improved, _) = improve_zone(share.zone, params)?;
+            parts.push(rejoin(cut.rest, improved, &share.next_interface));
+        }
+        (passes, before) = (passes + 1, worst);
+        (bad, worst) = (vec![], f64::MAX);
+        for (mesh, _) in &parts {
+            let (w, b) = bad_tets(mesh, target);
+            worst = worst.min(w);
+            bad.push(b);
+        }
+    }
+    Ok((parts.into_iter().map(|(m, _)| m).collect(), passes))
 }
