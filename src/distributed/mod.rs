@@ -108,9 +108,10 @@ pub fn mesh_on<C: Communicator>(
     let (part, part_params) = collect::agree(comm, meshed)?;
     let mut report = part.report;
     let min_dihedral_before_move_deg = report.dihedral_range()[0];
-    let (mesh, interface_passes) = move_interfaces(comm, part.mesh, part.interface, &part_params)?;
+    let (mesh, interface, interface_passes) =
+        move_interfaces(comm, part.mesh, part.interface, &part_params)?;
     crate::partition::measure_part(&mut report, &mesh);
-    let numbering = numbering::number(comm, &mesh)?;
+    let numbering = numbering::number(comm, &mesh, &interface)?;
     Ok(Part {
         rank,
         size,
@@ -123,7 +124,7 @@ pub fn mesh_on<C: Communicator>(
 }
 
 /// This rank's part with the interfaces moved (`partition::move_interfaces`, collective),
-/// and how many passes that took: every rank's zone around its interfaces and bad tets goes
+/// its triangles on its interfaces then, and how many passes that took: every rank's zone around its interfaces and bad tets goes
 /// to every rank, each improves the pieces it owns and puts them back into its part; again
 /// while the worst tet of all ranks is below the improvement target and the last pass raised
 /// it. (The zones are a layer of tets along the interfaces; every rank holds all of them for
@@ -133,7 +134,7 @@ fn move_interfaces<C: Communicator>(
     mut mesh: TetMesh,
     mut interface: Vec<[u32; 3]>,
     params: &Params,
-) -> Result<(TetMesh, u32), Error> {
+) -> Result<(TetMesh, Vec<[u32; 3]>, u32), Error> {
     use crate::partition as p;
     let rank = comm.rank() as usize;
     let target = params.effective_improve_target();
@@ -153,7 +154,7 @@ fn move_interfaces<C: Communicator>(
         (passes, before, bad) = (passes + 1, worst, b);
         worst = collect::all_min(comm, mine);
     }
-    Ok((mesh, passes))
+    Ok((mesh, interface, passes))
 }
 
 /// What rank 0 reports of each rank.

@@ -33,17 +33,18 @@ pub struct Numbering {
     pub neighbours: Vec<(usize, Vec<u32>)>,
 }
 
-/// Local ids of the vertices on faces of exactly one tet of `mesh`, ascending.
-fn surface_vertices(mesh: &TetMesh) -> Vec<u32> {
-    let faces = mesh.face_counts();
+/// Local ids of the vertices that other parts may share, ascending: those on the part's
+/// boundary triangles (the domain's boundary and region interfaces) and on its `interface`
+/// triangles with other parts. Every face of one tet of a part is one or the other, so every
+/// vertex a part shares (through a face, an edge or a vertex) is there; no face count of the
+/// whole part is needed.
+fn surface_vertices(mesh: &TetMesh, interface: &[[u32; 3]]) -> Vec<u32> {
     let mut on = vec![false; mesh.vertices.len()];
-    for (f, &n) in &faces {
-        if n == 1 {
-            for &v in f {
-                on[v as usize] = true;
-            }
-        }
-    }
+    mesh.boundary
+        .iter()
+        .chain(interface)
+        .flatten()
+        .for_each(|&v| on[v as usize] = true);
     (0..mesh.vertices.len() as u32)
         .filter(|&v| on[v as usize])
         .collect()
@@ -54,12 +55,17 @@ fn key(p: glam::DVec3) -> [u64; 3] {
     [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]
 }
 
-/// Numbers `mesh`, this rank's part, in the mesh of all ranks of `comm` (collective).
-pub fn number<C: Communicator>(comm: &C, mesh: &TetMesh) -> Result<Numbering, Error> {
+/// Numbers `mesh`, this rank's part, in the mesh of all ranks of `comm` (collective);
+/// `interface` holds its triangles on the interfaces with the other parts.
+pub fn number<C: Communicator>(
+    comm: &C,
+    mesh: &TetMesh,
+    interface: &[[u32; 3]],
+) -> Result<Numbering, Error> {
     let rank = comm.rank() as usize;
     let size = comm.size() as usize;
     let nv = mesh.vertices.len();
-    let candidates = surface_vertices(mesh);
+    let candidates = surface_vertices(mesh, interface);
     let mut mine: FxHashMap<[u64; 3], u32> = FxHashMap::default();
     let mut send = Vec::with_capacity(3 * candidates.len());
     let mut duplicate = None;
@@ -157,7 +163,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn surface_vertices_of_two_tets_are_all_five() {
+    fn shared_vertex_candidates_are_on_boundary_and_interface_triangles() {
         let mesh = TetMesh {
             vertices: vec![
                 glam::DVec3::ZERO,
@@ -165,10 +171,14 @@ mod tests {
                 glam::DVec3::Y,
                 glam::DVec3::Z,
                 glam::DVec3::ONE,
+                glam::DVec3::splat(0.3),
             ],
             tets: vec![[0, 1, 2, 3], [1, 2, 3, 4]],
+            boundary: vec![[0, 1, 2]],
+            boundary_markers: vec![1],
             ..TetMesh::default()
         };
-        assert_eq!(surface_vertices(&mesh), vec![0, 1, 2, 3, 4]);
+        assert_eq!(surface_vertices(&mesh, &[[1, 3, 4]]), vec![0, 1, 2, 3, 4]);
+        assert_eq!(surface_vertices(&mesh, &[]), vec![0, 1, 2]);
     }
 }
