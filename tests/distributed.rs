@@ -266,7 +266,85 @@ fn check_distributed(np: usize, name: &str, size: &str) {
     cells.sort_unstable();
     assert_eq!(piece_tets, mesh.tets.len());
     assert_eq!(cells, (0..mesh.tets.len() as u64).collect::<Vec<_>>());
+
+    // --binary: the same pieces in VTK's binary appended form (the run is deterministic).
+    let binary = dir.join("binary.pvtu");
+    run(
+        Some(np),
+        &[
+            input,
+            "-o",
+            binary.to_str().unwrap(),
+            "--size",
+            size,
+            "--binary",
+        ],
+    );
+    for (n, b) in names.iter().zip(pieces(&binary)) {
+        let ascii = read_vtu(&dir.join(n)).unwrap();
+        let bytes = std::fs::read(dir.join(&b)).unwrap();
+        let points: Vec<f64> = appended_array(&bytes, "Points", |c| {
+            f64::from_le_bytes(c.try_into().unwrap())
+        });
+        let coords: Vec<f64> = (ascii.mesh.vertices.iter())
+            .flat_map(|p| p.to_array())
+            .collect();
+        assert_eq!(points, coords, "{b}: points");
+        let int64 =
+            |name| appended_array(&bytes, name, |c| i64::from_le_bytes(c.try_into().unwrap()));
+        let connectivity: Vec<i64> = ascii
+            .mesh
+            .tets
+            .iter()
+            .flatten()
+            .map(|&v| v as i64)
+            .collect();
+        assert_eq!(int64("connectivity"), connectivity, "{b}: connectivity");
+        for (field, key) in [
+            (&ascii.point_fields, GLOBAL_NODE_ID),
+            (&ascii.cell_fields, GLOBAL_CELL_ID),
+        ] {
+            let (_, want) = field.iter().find(|(k, _)| k == key).expect(key);
+            let want: Vec<i64> = want.iter().map(|&x| x as i64).collect();
+            assert_eq!(int64(key), want, "{b}: {key}");
+        }
+        let regions = appended_array(&bytes, "region", |c| {
+            i32::from_le_bytes(c.try_into().unwrap())
+        });
+        assert_eq!(regions, ascii.mesh.tet_regions, "{b}: regions");
+    }
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The values of array `name` of a binary appended `.vtu` (`format="appended"`, raw, UInt64
+/// byte-count headers), each read from its bytes by `value`.
+fn appended_array<T>(file: &[u8], name: &str, value: impl Fn(&[u8]) -> T) -> Vec<T> {
+    let start = file
+        .windows(2)
+        .position(|w| w == b"\n_")
+        .expect("appended data")
+        + 2;
+    let xml = String::from_utf8_lossy(&file[..start]);
+    let tag = xml
+        .split("<DataArray")
+        .find(|t| t.contains(&format!("Name=\"{name}\"")))
+        .unwrap_or_else(|| panic!("no array {name}"));
+    let offset: usize = tag
+        .split("offset=\"")
+        .nth(1)
+        .expect("offset")
+        .split('"')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    let at = start + offset;
+    let bytes = u64::from_le_bytes(file[at..at + 8].try_into().unwrap()) as usize;
+    let size = std::mem::size_of::<T>();
+    file[at + 8..at + 8 + bytes]
+        .chunks_exact(size)
+        .map(value)
+        .collect()
 }
 
 #[test]

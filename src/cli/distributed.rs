@@ -72,10 +72,10 @@ fn run<C: mpi::traits::Communicator>(
         ));
     }
     let pvtu = out.is_some_and(output::is_pvtu);
-    if rank == 0 && pvtu && (opts.binary || quality_svg.is_some()) {
+    if rank == 0 && pvtu && quality_svg.is_some() {
         eprintln!(
-            "warning: the .pvtu pieces are written as ASCII and without a quality picture \
-             (--binary and --quality-svg apply to a gathered output)"
+            "warning: the .pvtu pieces are written without a quality picture (--quality-svg \
+             applies to a gathered output)"
         );
     }
     let mesher = distributed::collect::agree(
@@ -90,7 +90,7 @@ fn run<C: mpi::traits::Communicator>(
     })?;
     let whole = match out {
         Some(path) if pvtu => {
-            output::write_pieces(comm, &part, path)?;
+            output::write_pieces(comm, &part, path, opts.binary)?;
             None
         }
         Some(_) => output::gather(comm, &part)?,

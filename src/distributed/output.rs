@@ -4,6 +4,7 @@
 use super::collect::{agree, gather_varcount};
 use super::{Error, Part};
 use crate::io::vtu::{write_pvtu, write_vtu_piece, GlobalIds};
+use crate::io::vtu_binary::write_vtu_piece_binary;
 use crate::mesh::TetMesh;
 use glam::DVec3;
 use mpi::traits::*;
@@ -28,8 +29,14 @@ pub fn piece_path(pvtu: &Path, rank: usize) -> (PathBuf, String) {
 
 /// Writes each rank's piece and, on rank 0, the `.pvtu` at `pvtu` (collective). The pieces
 /// carry the region of each tet and the global ids (`GlobalNodeId`, `GlobalCellId`); there are
-/// no ghost cells.
-pub fn write_pieces<C: Communicator>(comm: &C, part: &Part, pvtu: &Path) -> Result<(), Error> {
+/// no ghost cells. `binary`: the pieces in VTK's binary appended form (about a third of the
+/// ASCII size), else ASCII.
+pub fn write_pieces<C: Communicator>(
+    comm: &C,
+    part: &Part,
+    pvtu: &Path,
+    binary: bool,
+) -> Result<(), Error> {
     let (path, _) = piece_path(pvtu, part.rank);
     let points: Vec<i64> = part
         .numbering
@@ -45,8 +52,12 @@ pub fn write_pieces<C: Communicator>(comm: &C, part: &Part, pvtu: &Path) -> Resu
         points: &points,
         cells: &cells,
     };
-    let written =
-        write_vtu_piece(&path, &part.mesh, ids, &[]).map_err(|e| Error::here(e.to_string()));
+    let written = if binary {
+        write_vtu_piece_binary(&path, &part.mesh, ids, &[])
+    } else {
+        write_vtu_piece(&path, &part.mesh, ids, &[])
+    };
+    let written = written.map_err(|e| Error::here(e.to_string()));
     agree(comm, written)?;
     // After every piece is there, so a reader never finds the .pvtu before its pieces.
     let listed = if part.rank == 0 {

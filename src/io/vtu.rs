@@ -65,22 +65,25 @@ pub fn write_vtu_piece(
     cell_fields: &[CellField],
 ) -> Result<(), IoError> {
     check_mesh(mesh, &field_lens(cell_fields)).map_err(|e| with_path(e, path))?;
-    if ids.points.len() != mesh.vertices.len() || ids.cells.len() != mesh.tets.len() {
-        return Err(with_path(
-            err_file(format!(
-                "{} global point ids for {} points, {} global cell ids for {} cells",
-                ids.points.len(),
-                mesh.vertices.len(),
-                ids.cells.len(),
-                mesh.tets.len()
-            )),
-            path,
-        ));
-    }
+    check_global_ids(mesh, ids).map_err(|e| with_path(e, path))?;
     let mut w = create(path)?;
     format_elements(&mut w, &Elements::new(mesh, None), cell_fields, Some(ids))
         .and_then(|_| w.flush())
         .map_err(|e| write_err(path, e))
+}
+
+/// One global id per point and per cell of `mesh`.
+pub(super) fn check_global_ids(mesh: &TetMesh, ids: GlobalIds) -> Result<(), IoError> {
+    if ids.points.len() != mesh.vertices.len() || ids.cells.len() != mesh.tets.len() {
+        return Err(err_file(format!(
+            "{} global point ids for {} points, {} global cell ids for {} cells",
+            ids.points.len(),
+            mesh.vertices.len(),
+            ids.cells.len(),
+            mesh.tets.len()
+        )));
+    }
+    Ok(())
 }
 
 /// Writes the `.pvtu` of a distributed mesh whose pieces ([`write_vtu_piece`], `cell_fields`

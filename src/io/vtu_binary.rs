@@ -11,7 +11,10 @@ use super::elements::Elements;
 use super::text::{
     check_mesh, check_mesh_io, check_quadratic, check_quadratic_io, create, with_path, write_err,
 };
-use super::vtu::{cell_type, field_lens, write_prologue};
+use super::vtu::{
+    cell_type, check_global_ids, field_lens, write_prologue, GlobalIds, GLOBAL_CELL_ID,
+    GLOBAL_NODE_ID,
+};
 use super::{CellField, IoError};
 use crate::mesh::{QuadraticNodes, TetMesh};
 use std::io::Write;
@@ -60,7 +63,7 @@ pub fn format_vtu_binary<W: Write>(
     cell_fields: &[CellField],
 ) -> std::io::Result<()> {
     check_mesh_io(mesh, &field_lens(cell_fields))?;
-    format_elements(w, &Elements::new(mesh, None), cell_fields)
+    format_elements(w, &Elements::new(mesh, None), cell_fields, None)
 }
 
 /// [`format_vtu_binary`] of ten-node tets (`VTK_QUADRATIC_TETRA`).
@@ -73,13 +76,30 @@ pub fn format_vtu_binary_quadratic<W: Write>(
 ) -> std::io::Result<()> {
     check_mesh_io(mesh, &field_lens(cell_fields))?;
     check_quadratic_io(mesh, quadratic)?;
-    format_elements(w, &Elements::new(mesh, Some(quadratic)), cell_fields)
+    format_elements(w, &Elements::new(mesh, Some(quadratic)), cell_fields, None)
+}
+
+/// Writes one piece of a distributed mesh in the binary appended form: [`write_vtu_binary`]'s
+/// file plus the global ids, as [`super::vtu::write_vtu_piece`] writes them.
+pub fn write_vtu_piece_binary(
+    path: &Path,
+    mesh: &TetMesh,
+    ids: GlobalIds,
+    cell_fields: &[CellField],
+) -> Result<(), IoError> {
+    check_mesh(mesh, &field_lens(cell_fields)).map_err(|e| with_path(e, path))?;
+    check_global_ids(mesh, ids).map_err(|e| with_path(e, path))?;
+    let mut w = create(path)?;
+    format_elements(&mut w, &Elements::new(mesh, None), cell_fields, Some(ids))
+        .and_then(|_| w.flush())
+        .map_err(|e| write_err(path, e))
 }
 
 fn format_elements<W: Write>(
     w: &mut W,
     el: &Elements,
     cell_fields: &[CellField],
+    ids: Option<GlobalIds>,
 ) -> std::io::Result<()> {
     let mesh = el.mesh;
     let (nv, nt) = (el.n_nodes(), mesh.tets.len());
@@ -94,7 +114,14 @@ fn format_elements<W: Write>(
         array("type=\"Int64\" Name=\"offsets\"".into(), 8 * nt),
         array("type=\"UInt8\" Name=\"types\"".into(), nt),
     ];
+    let point_ids = array(format!("type=\"Int64\" Name=\"{GLOBAL_NODE_ID}\""), 8 * nv);
     let mut cell_data = vec![array("type=\"Int32\" Name=\"region\"".into(), 4 * nt)];
+    if ids.is_some() {
+        cell_data.push(array(
+            format!("type=\"Int64\" Name=\"{GLOBAL_CELL_ID}\""),
+            8 * nt,
+        ));
+    }
     for f in cell_fields {
         cell_data.push(array(
             format!(
@@ -120,7 +147,18 @@ fn format_elements<W: Write>(
     for a in &cells {
         tag(w, a)?;
     }
-    writeln!(w, "</Cells>\n<CellData Scalars=\"region\">")?;
+    writeln!(w, "</Cells>")?;
+    if ids.is_some() {
+        writeln!(w, "<PointData GlobalIds=\"{GLOBAL_NODE_ID}\">")?;
+        tag(w, &point_ids)?;
+        writeln!(w, "</PointData>")?;
+        writeln!(
+            w,
+            "<CellData Scalars=\"region\" GlobalIds=\"{GLOBAL_CELL_ID}\">"
+        )?;
+    } else {
+        writeln!(w, "<CellData Scalars=\"region\">")?;
+    }
     for a in &cell_data {
         tag(w, a)?;
     }
@@ -145,11 +183,24 @@ fn format_elements<W: Write>(
     }
     header(w, cells[2].bytes)?;
     w.write_all(&vec![ty; nt])?;
+    if let Some(ids) = ids {
+        header(w, point_ids.bytes)?;
+        for x in ids.points {
+            w.write_all(&x.to_le_bytes())?;
+        }
+    }
     header(w, cell_data[0].bytes)?;
     for r in &mesh.tet_regions {
         w.write_all(&r.to_le_bytes())?;
     }
-    for (f, a) in cell_fields.iter().zip(&cell_data[1..]) {
+    if let Some(ids) = ids {
+        header(w, cell_data[1].bytes)?;
+        for x in ids.cells {
+            w.write_all(&x.to_le_bytes())?;
+        }
+    }
+    let fields_from = if ids.is_some() { 2 } else { 1 };
+    for (f, a) in cell_fields.iter().zip(&cell_data[fields_from..]) {
         header(w, a.bytes)?;
         for x in f.values {
             w.write_all(&x.to_le_bytes())?;
