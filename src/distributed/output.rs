@@ -4,7 +4,6 @@
 use super::collect::{agree, gather_varcount};
 use super::{Error, Part};
 use crate::io::vtu::{write_pvtu, write_vtu_piece, GlobalIds};
-use crate::io::vtu_binary::write_vtu_piece_binary;
 use crate::mesh::TetMesh;
 use glam::DVec3;
 use mpi::traits::*;
@@ -52,12 +51,8 @@ pub fn write_pieces<C: Communicator>(
         points: &points,
         cells: &cells,
     };
-    let written = if binary {
-        write_vtu_piece_binary(&path, &part.mesh, ids, &[])
-    } else {
-        write_vtu_piece(&path, &part.mesh, ids, &[])
-    };
-    let written = written.map_err(|e| Error::here(e.to_string()));
+    let written = write_vtu_piece(&path, &part.mesh, ids, &[], binary)
+        .map_err(|e| Error::here(e.to_string()));
     agree(comm, written)?;
     // After every piece is there, so a reader never finds the .pvtu before its pieces.
     let listed = if part.rank == 0 {

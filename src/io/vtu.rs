@@ -57,23 +57,30 @@ pub struct GlobalIds<'a> {
 }
 
 /// Writes one piece of a distributed mesh: [`write_vtu`]'s file plus the global ids
-/// ([`GLOBAL_NODE_ID`] point data, [`GLOBAL_CELL_ID`] cell data).
+/// ([`GLOBAL_NODE_ID`] point data, [`GLOBAL_CELL_ID`] cell data); `binary`: in VTK's binary
+/// appended form (`super::vtu_binary`), else ASCII.
 pub fn write_vtu_piece(
     path: &Path,
     mesh: &TetMesh,
     ids: GlobalIds,
     cell_fields: &[CellField],
+    binary: bool,
 ) -> Result<(), IoError> {
     check_mesh(mesh, &field_lens(cell_fields)).map_err(|e| with_path(e, path))?;
     check_global_ids(mesh, ids).map_err(|e| with_path(e, path))?;
     let mut w = create(path)?;
-    format_elements(&mut w, &Elements::new(mesh, None), cell_fields, Some(ids))
+    let written = if binary {
+        super::vtu_binary::format_piece(&mut w, mesh, ids, cell_fields)
+    } else {
+        format_elements(&mut w, &Elements::new(mesh, None), cell_fields, Some(ids))
+    };
+    written
         .and_then(|_| w.flush())
         .map_err(|e| write_err(path, e))
 }
 
 /// One global id per point and per cell of `mesh`.
-pub(super) fn check_global_ids(mesh: &TetMesh, ids: GlobalIds) -> Result<(), IoError> {
+fn check_global_ids(mesh: &TetMesh, ids: GlobalIds) -> Result<(), IoError> {
     if ids.points.len() != mesh.vertices.len() || ids.cells.len() != mesh.tets.len() {
         return Err(err_file(format!(
             "{} global point ids for {} points, {} global cell ids for {} cells",

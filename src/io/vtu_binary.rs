@@ -12,8 +12,7 @@ use super::text::{
     check_mesh, check_mesh_io, check_quadratic, check_quadratic_io, create, with_path, write_err,
 };
 use super::vtu::{
-    cell_type, check_global_ids, field_lens, write_prologue, GlobalIds, GLOBAL_CELL_ID,
-    GLOBAL_NODE_ID,
+    cell_type, field_lens, write_prologue, GlobalIds, GLOBAL_CELL_ID, GLOBAL_NODE_ID,
 };
 use super::{CellField, IoError};
 use crate::mesh::{QuadraticNodes, TetMesh};
@@ -79,20 +78,16 @@ pub fn format_vtu_binary_quadratic<W: Write>(
     format_elements(w, &Elements::new(mesh, Some(quadratic)), cell_fields, None)
 }
 
-/// Writes one piece of a distributed mesh in the binary appended form: [`write_vtu_binary`]'s
-/// file plus the global ids, as [`super::vtu::write_vtu_piece`] writes them.
-pub fn write_vtu_piece_binary(
-    path: &Path,
+/// One piece of a distributed mesh in the binary appended form: [`format_vtu_binary`]'s
+/// arrays plus the global ids, as [`super::vtu::write_vtu_piece`] writes them (which checks
+/// the mesh and the ids first).
+pub(super) fn format_piece<W: Write>(
+    w: &mut W,
     mesh: &TetMesh,
     ids: GlobalIds,
     cell_fields: &[CellField],
-) -> Result<(), IoError> {
-    check_mesh(mesh, &field_lens(cell_fields)).map_err(|e| with_path(e, path))?;
-    check_global_ids(mesh, ids).map_err(|e| with_path(e, path))?;
-    let mut w = create(path)?;
-    format_elements(&mut w, &Elements::new(mesh, None), cell_fields, Some(ids))
-        .and_then(|_| w.flush())
-        .map_err(|e| write_err(path, e))
+) -> std::io::Result<()> {
+    format_elements(w, &Elements::new(mesh, None), cell_fields, Some(ids))
 }
 
 fn format_elements<W: Write>(
