@@ -2,7 +2,7 @@
 //! [`super::vtu::format_vtu`] (points, connectivity, offsets, types, `region`, the cell fields),
 //! each `format="appended"` with its `offset` into one `<AppendedData encoding="raw">` block,
 //! where it is stored as a `UInt64` byte count followed by its little-endian values
-//! (`header_type="UInt64"`). Exact coordinates and no number formatting; about the ASCII file's
+//! (`header_type="UInt64"`). No number formatting or parsing; about the ASCII file's
 //! size (the Int64 connectivity takes as many bytes as short decimal ids: 134 against 131 MB
 //! for the pieces of 2.4e6 tets).
 //! Ten-node tets: [`format_vtu_binary_quadratic`], the arrays of
