@@ -35,19 +35,26 @@ fn has_mpirun() -> bool {
         .is_ok_and(|o| o.status.success())
 }
 
+/// `mpirun` on `np` ranks of this machine (more ranks than cores allowed, root allowed), the
+/// program and its arguments to add.
+fn mpirun(np: usize) -> Command {
+    let mut c = Command::new("mpirun");
+    c.args([
+        "--oversubscribe",
+        "--allow-run-as-root",
+        "-np",
+        &np.to_string(),
+    ]);
+    c
+}
+
 /// Runs `slivermesh mesh ARGS`, under `mpirun -np N` when `np` is given; panics with its
 /// output on failure.
 fn run(np: Option<usize>, args: &[&str]) -> String {
     let mut cmd = match np {
         Some(n) => {
-            let mut c = Command::new("mpirun");
-            c.args([
-                "--oversubscribe",
-                "--allow-run-as-root",
-                "-np",
-                &n.to_string(),
-                BIN,
-            ]);
+            let mut c = mpirun(n);
+            c.arg(BIN);
             c
         }
         None => Command::new(BIN),
@@ -468,12 +475,8 @@ fn c_abi_refine_mpi_on_two_and_three_ranks() {
         "mpicc failed:\n{}",
         String::from_utf8_lossy(&built.stderr)
     );
-    for np in ["2", "3"] {
-        let out = Command::new("mpirun")
-            .args(["--oversubscribe", "--allow-run-as-root", "-np", np])
-            .arg(&exe)
-            .output()
-            .unwrap();
+    for np in [2, 3] {
+        let out = mpirun(np).arg(&exe).output().unwrap();
         let text = format!(
             "{}{}",
             String::from_utf8_lossy(&out.stdout),
