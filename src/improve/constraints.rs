@@ -155,14 +155,7 @@ pub(crate) fn on_hull(w: &Work, v: u32, faces: &mut Vec<[u32; 3]>) -> bool {
         let tv = w.tets[t as usize];
         for skip in 0..4 {
             if tv[skip] != v {
-                let mut f = [0; 3];
-                let mut k = 0;
-                for (i, &x) in tv.iter().enumerate() {
-                    if i != skip {
-                        f[k] = x;
-                        k += 1;
-                    }
-                }
+                let mut f = crate::mesh::tet_face(&tv, skip);
                 f.sort_unstable();
                 faces.push(f);
             }
