@@ -445,32 +445,29 @@ pub fn move_interfaces(
     let target = params.effective_improve_target();
     let mut parts: Vec<(TetMesh, Vec<[u32; 3]>)> =
         parts.into_iter().map(|p| (p.mesh, p.interface)).collect();
-    let mut bad: Vec<Vec<bool>> = vec![];
-    let mut worst = f64::MAX;
-    for (mesh, _) in &parts {
-        let (w, b) = bad_tets(mesh, target);
-        worst = worst.min(w);
-        bad.push(b);
-    }
+    // The worst tet of all parts, and each part's tets below the target.
+    let measure = |parts: &[(TetMesh, Vec<[u32; 3]>)]| {
+        let (worst, bad): (Vec<f64>, Vec<Vec<bool>>) =
+            parts.iter().map(|(mesh, _)| bad_tets(mesh, target)).unzip();
+        (worst.into_iter().fold(f64::MAX, f64::min), bad)
+    };
+    let (mut worst, mut bad) = measure(&parts);
     let (mut passes, mut before) = (0, worst);
     while another_pass(passes, before, worst, target) {
-        let cuts: Vec<Cut> = (parts.into_iter().zip(&bad))
-            .map(|((mesh, interface), bad)| cut_zone(mesh, &interface, bad))
-            .collect();
-        let zones: Vec<TetMesh> = cuts.iter().map(|c| c.zone.clone()).collect();
+        let (rests, zones): (Vec<TetMesh>, Vec<TetMesh>) = (parts.into_iter().zip(&bad))
+            .map(|((mesh, interface), bad)| {
+                let cut = cut_zone(mesh, &interface, bad);
+                (cut.rest, cut.zone)
+            })
+            .unzip();
         let shares = share_zones(&zones);
         parts = vec![];
-        for (cut, share) in cuts.into_iter().zip(shares) {
+        for (rest, share) in rests.into_iter().zip(shares) {
             let (improved, _) = improve_zone(share.zone, params)?;
-            parts.push(rejoin(cut.rest, improved, &share.next_interface));
+            parts.push(rejoin(rest, improved, &share.next_interface));
         }
         (passes, before) = (passes + 1, worst);
-        (bad, worst) = (vec![], f64::MAX);
-        for (mesh, _) in &parts {
-            let (w, b) = bad_tets(mesh, target);
-            worst = worst.min(w);
-            bad.push(b);
-        }
+        (worst, bad) = measure(&parts);
     }
     Ok((parts.into_iter().map(|(m, _)| m).collect(), passes))
 }
