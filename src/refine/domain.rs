@@ -430,16 +430,93 @@ impl Domain {
         None
     }
 
-    /// Whether a point may be inserted at `p` without removing a frozen subfacet (probes its
-    /// cavity from `hint`; a duplicate may not).
-    pub fn may_insert_at(&mut self, p: DVec3, hint: Option<u32>) -> bool {
+    /// With frozen facets, the subsegments that inserting `cavity`'s point would remove (every
+    /// tet around them in the cavity). A frozen facet may keep such a subsegment from being
+    /// split, and then it could not be recovered; without frozen facets none is looked for.
+    pub fn subsegments_removed_by(&self, cavity: &Cavity) -> Vec<(u32, u32)> {
+        let mut out = vec![];
+        if !self.any_frozen {
+            return out;
+        }
+        let (removed, _) = self.dt.cavity(cavity);
+        let on_segment = |x: u32| {
+            x != crate::delaunay::INFINITE
+                && matches!(
+                    self.kind[x as usize],
+                    VertexKind::Input | VertexKind::Segment(_)
+                )
+        };
+        let mut ring = vec![];
+        for &t in removed {
+            let v = self.dt.tet(t);
+            let on = v.map(on_segment);
+            for i in 0..4 {
+                for j in i + 1..4 {
+                    let key = seg_key(v[i], v[j]);
+                    if on[i]
+                        && on[j]
+                        && self.subsegs.contains_key(&key)
+                        && !out.contains(&key)
+                        && self.dt.edge_ring(key.0, key.1, &mut ring)
+                        && ring.iter().all(|r| removed.contains(r))
+                    {
+                        out.push(key);
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// Whether a point that splits a boundary element (the subsegment `splitting`, if it is
+    /// one) may go at `p`: its cavity (`probed` when that is a current probe of `p`, else
+    /// probed from `hint`) removes no frozen subfacet, nor, when `spare_others`, another
+    /// subsegment that no point could split then (`split_point_clear_of_frozen`, not looking
+    /// further): that one could not be recovered. A duplicate may not go.
+    pub fn may_split_at(
+        &mut self,
+        p: DVec3,
+        hint: Option<u32>,
+        probed: Option<&Cavity>,
+        splitting: Option<(u32, u32)>,
+    ) -> bool {
+        self.may_split_looking(p, hint, probed, splitting, true)
+    }
+
+    pub(super) fn may_split_looking(
+        &mut self,
+        p: DVec3,
+        hint: Option<u32>,
+        probed: Option<&Cavity>,
+        splitting: Option<(u32, u32)>,
+        spare_others: bool,
+    ) -> bool {
         if !self.any_frozen {
             return true;
         }
-        match self.dt.probe(p, hint) {
-            crate::delaunay::Probe::Cavity(c) => self.frozen_removed_by(&c).is_none(),
-            crate::delaunay::Probe::Duplicate(_) => false,
+        let probe;
+        let cavity = match probed {
+            Some(c) if c.point() == p && self.dt.is_current(c) => c,
+            _ => match self.dt.probe(p, hint) {
+                crate::delaunay::Probe::Cavity(c) => {
+                    probe = c;
+                    &probe
+                }
+                crate::delaunay::Probe::Duplicate(_) => return false,
+            },
+        };
+        if self.frozen_removed_by(cavity).is_some() {
+            return false;
         }
+        if !spare_others {
+            return true;
+        }
+        let others: Vec<(u32, u32)> = (self.subsegments_removed_by(cavity).into_iter())
+            .filter(|&k| Some(k) != splitting)
+            .collect();
+        others
+            .into_iter()
+            .all(|(a, b)| self.split_point_looking(a, b, false).is_some())
     }
 
     /// Checks that every frozen subfacet is a face of the triangulation.

@@ -127,6 +127,12 @@ impl Domain {
         if let Some((a, b)) = scan.seg {
             return Some(Boundary::Segment(a, b));
         }
+        // A subsegment the point would remove without encroaching it (one left encroached):
+        // split first, as if encroached, since a frozen facet may keep it from being split
+        // afterwards.
+        if let Some((a, b)) = dom.subsegments_removed_by(cavity).into_iter().min() {
+            return Some(Boundary::Segment(a, b));
+        }
         if let Some((fi, t)) = scan.facet {
             return Some(Boundary::Facet(fi, t));
         }
@@ -294,8 +300,11 @@ impl Domain {
             None => (cf, None),
         };
         let hint = self.dt.vertex_tet(t[0]);
-        if !self.may_insert_with(p, hint, &cavity) {
+        if !self.may_split_at(p, hint, cavity.as_ref(), None) {
             return Ok(Err(Refusal::FrozenInterface));
+        }
+        if self.split_removed_first(p, hint, None)? {
+            return Ok(Ok(BoundaryKind::Segment));
         }
         self.split_in_facet(f, p, hint, cavity)?;
         Ok(Ok(BoundaryKind::Facet))
@@ -353,21 +362,14 @@ impl Domain {
             }
         };
         let hint = self.dt.vertex_tet(a);
-        if !self.may_insert_with(p, hint, &cavity) {
+        if !self.may_split_at(p, hint, cavity.as_ref(), Some(seg_key(a, c))) {
             return Ok(Err(Refusal::FrozenInterface));
+        }
+        if self.split_removed_first(p, hint, Some(seg_key(a, c)))? {
+            return Ok(Ok(()));
         }
         self.split_subsegment(a, c, p, cavity)?;
         Ok(Ok(()))
-    }
-
-    /// [`Domain::may_insert_at`], with `p`'s probe when there is one (kept current).
-    fn may_insert_with(&mut self, p: DVec3, hint: Option<u32>, probed: &Option<Cavity>) -> bool {
-        match probed {
-            Some(c) if c.point() == p && self.dt.is_current(c) => {
-                self.frozen_removed_by(c).is_none()
-            }
-            _ => self.may_insert_at(p, hint),
-        }
     }
 }
 

@@ -95,11 +95,15 @@ impl Domain {
                 if !spend(budget) {
                     return Ok(Settled::BudgetSpent);
                 }
-                let Some(p) = self.split_point_clear_of_frozen(a, b) else {
+                let Some(p) = self.split_point_clear_of_frozen(a, b, status) else {
                     let (pa, pb) = (self.point(a), self.point(b));
                     frozen_missing(status, &format!("subsegment ({a}, {b}) from {pa} to {pb}"))?;
                     continue;
                 };
+                if self.split_removed_first(p, self.dt.vertex_tet(a), Some((a, b)))? {
+                    self.dirty_segs.push((a, b));
+                    continue;
+                }
                 self.split_subsegment(a, b, p, None)?;
                 continue;
             }
@@ -241,10 +245,14 @@ impl Domain {
                     if !spend(budget) {
                         return Ok(false);
                     }
-                    let Some(p) = self.split_point_clear_of_frozen(x, y) else {
+                    let Some(p) = self.split_point_clear_of_frozen(x, y, status) else {
                         frozen_missing(status, &what)?;
                         return Ok(true);
                     };
+                    if self.split_removed_first(p, self.dt.vertex_tet(x), Some((x, y)))? {
+                        self.dirty_tris.push(tri);
+                        return Ok(true);
+                    }
                     self.split_subsegment(x, y, p, None)?;
                 }
             }
@@ -265,10 +273,14 @@ impl Domain {
             if !spend(budget) {
                 return Ok(false);
             }
-            let Some(p) = self.split_point_clear_of_frozen(x, y) else {
+            let Some(p) = self.split_point_clear_of_frozen(x, y, status) else {
                 frozen_missing(status, &what)?;
                 return Ok(true);
             };
+            if self.split_removed_first(p, self.dt.vertex_tet(x), Some((x, y)))? {
+                self.dirty_tris.push(tri);
+                return Ok(true);
+            }
             self.split_subsegment(x, y, p, None)?;
             self.dirty_tris.push(tri); // looked at again, as above
             return Ok(true);
@@ -283,27 +295,78 @@ impl Domain {
             frozen_missing(status, &what)?;
             return Ok(true);
         };
+        if self.split_removed_first(p, hint, None)? {
+            self.dirty_tris.push(tri);
+            return Ok(true);
+        }
         self.split_in_facet(f, p, hint, None)?;
         Ok(true)
     }
 
+    /// With frozen facets: splits first a subsegment other than `splitting` that a point at
+    /// `p` would remove, and says whether it did. Once the point is in, a frozen facet could
+    /// keep that subsegment from being split, and then it could not be recovered; now it can
+    /// be split (`p` was chosen so, `Domain::may_split_at`).
+    pub(super) fn split_removed_first(
+        &mut self,
+        p: DVec3,
+        hint: Option<u32>,
+        splitting: Option<(u32, u32)>,
+    ) -> Result<bool, MeshError> {
+        if !self.any_frozen {
+            return Ok(false);
+        }
+        let crate::delaunay::Probe::Cavity(cavity) = self.dt.probe(p, hint) else {
+            return Ok(false);
+        };
+        let removed = self.subsegments_removed_by(&cavity);
+        let Some((x, y)) = removed.into_iter().find(|&k| Some(k) != splitting) else {
+            return Ok(false);
+        };
+        let Some(q) = self.split_point_clear_of_frozen(x, y, Status::Encroached) else {
+            return Ok(false);
+        };
+        self.split_subsegment(x, y, q, None)?;
+        Ok(true)
+    }
+
     /// Where to split subsegment ab: `segment_split_point`, or, when that point's insertion
-    /// would remove a frozen subfacet, the first point of ab at 0.4, 0.6, 0.3, 0.7, 0.2 or 0.8
-    /// of its length that does not. None for a frozen subsegment or when no point will do.
-    fn split_point_clear_of_frozen(&mut self, a: u32, b: u32) -> Option<DVec3> {
+    /// would remove a frozen subfacet (or a subsegment no point could split then), the first
+    /// point of ab at 0.4, 0.6, 0.3, 0.7, 0.2 or 0.8 of its length that does not; failing
+    /// that, when the element the split is for (`status`) is missing, the first that removes
+    /// no frozen subfacet (an encroached one is better left so). None for a frozen subsegment
+    /// or when no point will do.
+    pub(super) fn split_point_clear_of_frozen(
+        &mut self,
+        a: u32,
+        b: u32,
+        status: Status,
+    ) -> Option<DVec3> {
+        let p = self.split_point_looking(a, b, true);
+        match status {
+            Status::Missing => p.or_else(|| self.split_point_looking(a, b, false)),
+            _ => p,
+        }
+    }
+
+    /// [`Domain::split_point_clear_of_frozen`], looking at the other subsegments a point would
+    /// remove only when `spare_others`.
+    pub(super) fn split_point_looking(
+        &mut self,
+        a: u32,
+        b: u32,
+        spare_others: bool,
+    ) -> Option<DVec3> {
         if self.is_frozen_subsegment(seg_key(a, b)) {
             return None;
         }
         let hint = self.dt.vertex_tet(a);
-        let p = self.segment_split_point(a, b);
-        if self.may_insert_at(p, hint) {
-            return Some(p);
-        }
         let (pa, pb) = (self.point(a), self.point(b));
-        [0.4, 0.6, 0.3, 0.7, 0.2, 0.8]
-            .into_iter()
-            .map(|t| pa + (pb - pa) * t)
-            .find(|&q| self.may_insert_at(q, hint))
+        let first = self.segment_split_point(a, b);
+        let splitting = Some(seg_key(a, b));
+        std::iter::once(first)
+            .chain([0.4, 0.6, 0.3, 0.7, 0.2, 0.8].map(|t| pa + (pb - pa) * t))
+            .find(|&q| self.may_split_looking(q, hint, None, splitting, spare_others))
     }
 
     /// `p` to split a subfacet with corners `corners` of facet `f`, or, when its insertion
@@ -316,7 +379,7 @@ impl Domain {
         corners: [DVec3; 3],
         hint: Option<u32>,
     ) -> Option<DVec3> {
-        if self.may_insert_at(p, hint) {
+        if self.may_split_at(p, hint, None, None) {
             return Some(p);
         }
         let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
@@ -324,7 +387,9 @@ impl Domain {
         candidates.extend(corners.iter().map(|&c| (centroid + c) * 0.5));
         candidates.into_iter().find(|&q| {
             let fm = &self.facets[f as usize];
-            fm.locate(q).is_some() && fm.can_insert(q).is_ok() && self.may_insert_at(q, hint)
+            fm.locate(q).is_some()
+                && fm.can_insert(q).is_ok()
+                && self.may_split_at(q, hint, None, None)
         })
     }
 
