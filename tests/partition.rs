@@ -206,34 +206,38 @@ fn where_the_worst_are(m: &TetMesh) {
 
 /// Approximate mode: `plan` makes the surface once and the parts mesh it in keep mode; with
 /// the interfaces moved every part is at the approximate mode's improvement target or above.
+/// In 2 parts a subsegment of fandisk's surface next to the interface is one that a frozen
+/// interface triangle keeps from being split: the parts' refinement must not remove it.
 #[test]
-fn fandisk_approximate_in_three_parts() {
+fn fandisk_approximate_in_two_and_three_parts() {
     let input = common::read_model("off/fandisk.off");
     let params = Params {
         surface_mode: slivermesh::run::params::SurfaceMode::Approximate,
         ..Params::default()
     };
-    let plan = slivermesh::partition::plan(&input, &params, None, 3).unwrap();
-    let parts: Vec<_> = (0..3)
-        .map(|p| slivermesh::partition::mesh_part(&plan, p).unwrap())
-        .collect();
-    let (moved, _) = slivermesh::partition::move_interfaces(parts, plan.params()).unwrap();
-    let whole = slivermesh::partition::glue(&moved).0;
-    common::check_orientation(&whole);
-    check_conforming(&whole);
-    // Measured 26.00 degrees after moving the interfaces (one pass: 20.84), 14.45 before
-    // (serial 20.00).
-    let min = slivermesh::quality::measure(&whole)
-        .unwrap()
-        .min_dihedral_deg;
-    println!(
-        "fandisk in 3 parts: {} tets, min dihedral {min:.2}",
-        whole.tets.len()
-    );
-    assert!(
-        min >= slivermesh::run::params::APPROXIMATE_IMPROVE_TARGET,
-        "{min}"
-    );
+    for n in [2, 3] {
+        let plan = slivermesh::partition::plan(&input, &params, None, n).unwrap();
+        let parts: Vec<_> = (0..n)
+            .map(|p| slivermesh::partition::mesh_part(&plan, p).unwrap())
+            .collect();
+        let (moved, _) = slivermesh::partition::move_interfaces(parts, plan.params()).unwrap();
+        let whole = slivermesh::partition::glue(&moved).0;
+        common::check_orientation(&whole);
+        check_conforming(&whole);
+        // Measured 22.90 / 25.98 degrees in 2 / 3 parts after moving the interfaces, 15.60 /
+        // 14.45 before (serial 20.00).
+        let min = slivermesh::quality::measure(&whole)
+            .unwrap()
+            .min_dihedral_deg;
+        println!(
+            "fandisk in {n} parts: {} tets, min dihedral {min:.2}",
+            whole.tets.len()
+        );
+        assert!(
+            min >= slivermesh::run::params::APPROXIMATE_IMPROVE_TARGET,
+            "{n} parts: {min}"
+        );
+    }
 }
 
 /// Boundary triangles with their markers, by their corners' coordinates.
