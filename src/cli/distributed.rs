@@ -117,11 +117,19 @@ fn run<C: mpi::traits::Communicator>(
         ("global_min_dihedral_deg", min_dihedral.into()),
         ("global_max_dihedral_deg", max_dihedral.into()),
         ("interface_passes", part.interface_passes.into()),
+        ("plan_attempt", part.plan_attempt.into()),
     ];
     println!(
         "{}",
         ranks_table(&ranks, n.n_vertices, n.n_tets, part.interface_passes)
     );
+    if part.plan_attempt > 0 {
+        println!(
+            "  (a part could not be meshed on the first partition: partition {} of {} was)\n",
+            part.plan_attempt + 1,
+            slivermesh::partition::PLAN_ATTEMPTS
+        );
+    }
     match (whole, out) {
         (Some(mesh), out) => {
             let written = Written {

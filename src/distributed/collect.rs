@@ -29,6 +29,13 @@ pub fn all_min<C: Communicator>(comm: &C, x: f64) -> f64 {
     min
 }
 
+/// The largest of every rank's `x`, on every rank.
+pub fn all_max<C: Communicator>(comm: &C, x: u32) -> u32 {
+    let mut max = x;
+    comm.all_reduce_into(&x, &mut max, SystemOperation::max());
+    max
+}
+
 /// Every rank's `n`, on every rank.
 pub fn all_counts<C: Communicator>(comm: &C, n: usize) -> Vec<u64> {
     let mut all = vec![0u64; comm.size() as usize];

@@ -81,6 +81,9 @@ pub struct Part {
     pub min_dihedral_before_move_deg: f64,
     /// How many times the interfaces were moved (the same on every rank).
     pub interface_passes: u32,
+    /// Which partition the parts were meshed from (0: the first; another when a part's
+    /// refinement failed, `partition::plan_attempt`).
+    pub plan_attempt: u32,
     pub numbering: Numbering,
 }
 
@@ -97,15 +100,19 @@ pub fn mesh_on<C: Communicator>(
 ) -> Result<Part, Error> {
     let rank = comm.rank() as usize;
     let size = comm.size() as usize;
-    let meshed = crate::partition::plan(input, params, spacing, size)
-        .and_then(|plan| {
-            let params = plan.params().clone();
-            // The coarse mesh and the band are dropped before the part is refined.
-            let part = plan.into_part(rank)?;
-            Ok((part.mesh()?, params))
-        })
-        .map_err(|e| Error::here(format!("rank {rank}: {e}")));
-    let (part, part_params) = collect::agree(comm, meshed)?;
+    let mut attempt = 0;
+    let (part, part_params) = loop {
+        let meshed = mesh_part(input, params, spacing, size, rank, attempt);
+        // Another partition when a part's refinement failed on some rank (not when planning
+        // did: every rank plans alike).
+        let retry = matches!(meshed, Err((_, true))) as u32;
+        if collect::all_max(comm, retry) == 1 && attempt + 1 < crate::partition::PLAN_ATTEMPTS {
+            attempt += 1;
+            continue;
+        }
+        let meshed = meshed.map_err(|(e, _)| Error::here(format!("rank {rank}: {e}")));
+        break collect::agree(comm, meshed)?;
+    };
     let mut report = part.report;
     let min_dihedral_before_move_deg = report.dihedral_range()[0];
     let (mesh, interface, interface_passes) =
@@ -119,8 +126,32 @@ pub fn mesh_on<C: Communicator>(
         report,
         min_dihedral_before_move_deg,
         interface_passes,
+        plan_attempt: attempt,
         numbering,
     })
+}
+
+/// This rank's part of the partition's `attempt`-th plan (`partition::plan_attempt`) and the
+/// parameters it was meshed with, or the error and whether it came from the part's
+/// refinement (after planning, which every rank does alike).
+fn mesh_part(
+    input: &PlcInput,
+    params: &Params,
+    spacing: Option<&dyn Spacing>,
+    size: usize,
+    rank: usize,
+    attempt: u32,
+) -> Result<(crate::partition::MeshedPart, Params), (crate::run::error::MeshError, bool)> {
+    let plan = crate::partition::plan_attempt(input, params, spacing, size, attempt)
+        .map_err(|e| (e, false))?;
+    let params = plan.params().clone();
+    // The coarse mesh and the band are dropped before the part is refined.
+    let part = plan.into_part(rank).map_err(|e| (e, false))?;
+    let meshed = part.mesh().map_err(|e| {
+        let internal = matches!(e, crate::run::error::MeshError::Internal(_));
+        (e, internal)
+    })?;
+    Ok((meshed, params))
 }
 
 /// This rank's part with the interfaces moved (`partition::move_interfaces`, collective),

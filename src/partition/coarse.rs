@@ -41,6 +41,7 @@ impl Coarse {
         params: &Params,
         spacing: &dyn Spacing,
         parts: usize,
+        cut_shift: f64,
     ) -> Result<Coarse, MeshError> {
         let coarse_params = Params {
             order: 1,
@@ -65,7 +66,7 @@ impl Coarse {
                 mesh.tets.len()
             )));
         }
-        let mut part_of = cut(&mesh, spacing, parts);
+        let mut part_of = cut(&mesh, spacing, parts, cut_shift);
         smooth(&mesh, &mut part_of);
         Ok(Coarse {
             parts,
@@ -90,8 +91,10 @@ pub(super) fn sorted_faces(t: [u32; 4]) -> [[u32; 3]; 4] {
 }
 
 /// Each tet's part: the tets in Hilbert order of their centroids, cut into `parts` runs of
-/// equal estimated final tet count (volume / f(centroid)^3).
-fn cut(mesh: &TetMesh, spacing: &dyn Spacing, parts: usize) -> Vec<u32> {
+/// equal estimated final tet count (volume / f(centroid)^3), the cuts moved along the order by
+/// `shift` (a fraction of a part's share, below one half: the first and last parts are that
+/// much smaller or larger).
+fn cut(mesh: &TetMesh, spacing: &dyn Spacing, parts: usize, shift: f64) -> Vec<u32> {
     let corners = |t: &[u32; 4]| t.map(|v| mesh.vertices[v as usize]);
     let centroids: Vec<DVec3> = (mesh.tets.iter())
         .map(|t| corners(t).iter().sum::<DVec3>() / 4.0)
@@ -112,7 +115,7 @@ fn cut(mesh: &TetMesh, spacing: &dyn Spacing, parts: usize) -> Vec<u32> {
     for (k, &t) in order.iter().enumerate() {
         // The part whose share the middle of this tet's weight falls in, but never fewer
         // tets left than parts to fill.
-        let share = ((done + 0.5 * weight[t as usize]) / total * parts as f64) as usize;
+        let share = ((done + 0.5 * weight[t as usize]) / total * parts as f64 + shift) as usize;
         let left = order.len() - k;
         let part = share.min(parts - 1).max(parts.saturating_sub(left));
         part_of[t as usize] = part as u32;

@@ -106,6 +106,30 @@ pub fn plan<'s>(
     spacing: Option<&'s dyn Spacing>,
     parts: usize,
 ) -> Result<Plan<'s>, MeshError> {
+    plan_attempt(input, params, spacing, parts, 0)
+}
+
+/// How many partitions [`plan_attempt`] tries.
+pub const PLAN_ATTEMPTS: u32 = 3;
+
+/// The cut's shift along the Hilbert order per attempt (fractions of a part's share).
+const CUT_SHIFTS: [f64; PLAN_ATTEMPTS as usize] = [0.0, -0.2, 0.2];
+
+/// [`plan`] with the cuts between the parts moved by attempt number (0: `plan`'s; 1 and 2:
+/// moved back and forth by a fifth of a part's share). For another try when a part could not
+/// be meshed: a part's refinement can fail next to its frozen interface (a boundary element
+/// that no point may split without removing an interface triangle), and elsewhere the
+/// interface meets the boundary otherwise.
+pub fn plan_attempt<'s>(
+    input: &PlcInput,
+    params: &Params,
+    spacing: Option<&'s dyn Spacing>,
+    parts: usize,
+    attempt: u32,
+) -> Result<Plan<'s>, MeshError> {
+    let cut_shift = *CUT_SHIFTS.get(attempt as usize).ok_or_else(|| {
+        MeshError::InvalidInput(format!("plan attempt {attempt} of {PLAN_ATTEMPTS}"))
+    })?;
     if parts == 0 {
         return Err(MeshError::InvalidInput(
             "a partition needs at least one part".into(),
@@ -134,7 +158,7 @@ pub fn plan<'s>(
         }
     };
     let input = boundary.as_ref().unwrap_or(input);
-    let coarse = Coarse::new(input, &params, spacing.get(), parts)?;
+    let coarse = Coarse::new(input, &params, spacing.get(), parts, cut_shift)?;
     let band = Band::new(&coarse, &params, spacing.get())?;
     Ok(Plan {
         params,
