@@ -204,14 +204,19 @@ impl Domain {
         let small: Vec<u32> = (acute.segment_angles.iter())
             .filter(|a| {
                 a.degrees < SMALL_ANGLE_DEG
-                    && !(a.segments.iter()).any(|&s| self.frozen_only(&self.segments[s]))
+                    && !(a.segments.iter()).any(|&s| self.on_frozen(&self.segments[s]))
             })
             .map(|a| a.vertex)
             .collect();
         self.small_angle_vertices.extend(small);
+        // Nor is a dihedral angle with a frozen facet a feature: its triangles are never split,
+        // and being encroached is allowed them, so splits next to it cannot cascade.
         self.small_angle_segments.extend(
             (acute.dihedral_angles.iter())
-                .filter(|a| a.degrees < SMALL_ANGLE_DEG)
+                .filter(|a| {
+                    a.degrees < SMALL_ANGLE_DEG
+                        && !(a.facets.iter()).any(|&f| self.frozen[f as usize])
+                })
                 .map(|a| a.segment as u32),
         );
         for &s in &self.small_angle_segments {
@@ -373,6 +378,11 @@ impl Domain {
                 .collect();
             self.acute_vertices = acute_vertices_of(self.dt.points(), &open);
         }
+    }
+
+    /// Whether a facet of segment `s` is frozen (it is never split then).
+    fn on_frozen(&self, s: &Segment) -> bool {
+        self.any_frozen && s.facets.iter().any(|&f| self.frozen[f as usize])
     }
 
     /// Whether every facet of segment `s` is frozen.
