@@ -224,7 +224,7 @@ fn fandisk_approximate_in_two_and_three_parts() {
         let whole = slivermesh::partition::glue(&moved).0;
         common::check_orientation(&whole);
         check_conforming(&whole);
-        // Measured 22.90 / 25.98 degrees in 2 / 3 parts after moving the interfaces, 15.60 /
+        // Measured 22.90 / 25.84 degrees in 2 / 3 parts after moving the interfaces, 16.51 /
         // 14.45 before (serial 20.00).
         let min = slivermesh::quality::measure(&whole)
             .unwrap()
