@@ -385,7 +385,19 @@ impl FacetMesh {
             let a: f64 = outer.iter().map(area).sum::<f64>() - holes.iter().map(area).sum::<f64>();
             fm.expected_area = Some(a);
         }
+        fm.shrink_to_fit();
         Ok(fm)
+    }
+
+    /// Gives back the spare capacity of a new facet's arrays: a PLC can have many small facets
+    /// (a partition's interfaces are one facet a triangle), most of which are never split.
+    fn shrink_to_fit(&mut self) {
+        self.tris.shrink_to_fit();
+        self.gid.shrink_to_fit();
+        self.p3.shrink_to_fit();
+        self.p2.shrink_to_fit();
+        self.vtri.shrink_to_fit();
+        self.local.shrink_to_fit();
     }
 
     /// The area [`Self::validate`] expects the facet's triangles to cover, when the caller
