@@ -110,7 +110,14 @@ pub fn mesh_on<C: Communicator>(
             attempt += 1;
             continue;
         }
-        let meshed = meshed.map_err(|(e, _)| Error::here(format!("rank {rank}: {e}")));
+        let meshed = meshed.map_err(|(e, _)| match attempt {
+            0 => Error::here(format!("rank {rank}: {e}")),
+            _ => Error::here(format!(
+                "rank {rank}, partition {} of {}: {e}",
+                attempt + 1,
+                crate::partition::PLAN_ATTEMPTS
+            )),
+        });
         break collect::agree(comm, meshed)?;
     };
     let mut report = part.report;

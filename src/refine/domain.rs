@@ -493,6 +493,8 @@ impl Domain {
         self.may_split_looking(p, hint, probed, splitting, true)
     }
 
+    /// [`Domain::may_split_at`], looking at the other subsegments the point would remove only
+    /// when `spare_others` (a split point for one of those is not looked at further).
     pub(super) fn may_split_looking(
         &mut self,
         p: DVec3,
