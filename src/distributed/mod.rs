@@ -87,9 +87,6 @@ pub struct Part {
     pub numbering: Numbering,
 }
 
-/// How many times the interfaces are moved (`partition::move_interfaces`).
-pub const INTERFACE_PASSES: u32 = 1;
-
 /// Meshes `input` on all ranks of `comm` (collective): plans the partition into one part per
 /// rank, meshes this rank's part and numbers it globally.
 pub fn mesh_on<C: Communicator>(
