@@ -251,6 +251,11 @@ fn mesh_plc(
         })
         .collect();
     let mut mesh = crate::pipeline::improve(mesh, &mut report, Some(&facets_only), params)?;
+    if !report.improvement.changed() {
+        // `mesh_frozen` without improvement leaves the shape figures unmeasured: the report
+        // would say 0 degrees for a part that needed no improvement.
+        report.measure_shapes(&mesh);
+    }
     let interface: Vec<[u32; 3]> = (mesh.boundary.iter())
         .filter(|b| frozen_corners.contains(&zone::corners(&b[..], &mesh.vertices)))
         .copied()
