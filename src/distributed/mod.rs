@@ -173,11 +173,12 @@ fn move_interfaces<C: Communicator>(
     use crate::partition as p;
     let rank = comm.rank() as usize;
     let target = params.effective_improve_target();
-    let (worst, mut bad) = p::bad_tets(&mesh, target);
+    let (worst, over_rho, mut seeds) = p::bad_tets(&mesh, target, params.rho0);
     let mut worst = collect::all_min(comm, worst);
+    let over_rho = collect::all_max(comm, over_rho as u32) > 0;
     let (mut passes, mut before) = (0, worst);
-    while p::another_pass(passes, before, worst, target) {
-        let cut = p::cut_zone(mesh, &interface, &bad);
+    while p::another_pass(passes, before, worst, target, over_rho) {
+        let cut = p::cut_zone(mesh, &interface, &seeds);
         let zones = collect::all_gather_meshes(comm, &cut.zone)?;
         let share = p::share_zones(&zones).swap_remove(rank);
         drop(zones);
@@ -185,8 +186,8 @@ fn move_interfaces<C: Communicator>(
             .map_err(|e| Error::here(format!("rank {rank}, moving the interfaces: {e}")));
         let (improved, _) = collect::agree(comm, improved)?;
         (mesh, interface) = p::rejoin(cut.rest, improved, &share.next_interface);
-        let (mine, b) = p::bad_tets(&mesh, target);
-        (passes, before, bad) = (passes + 1, worst, b);
+        let (mine, _, b) = p::bad_tets(&mesh, target, params.rho0);
+        (passes, before, seeds) = (passes + 1, worst, b);
         worst = collect::all_min(comm, mine);
     }
     Ok((mesh, interface, passes))

@@ -215,6 +215,11 @@ pub(crate) fn classify(w: &mut Work, input: Option<&PlcInput>) -> (Vec<Constrain
 
     let mut patches = join_flat_patches(w, &seg_edge);
     let normals = number_patches(w, &mut patches);
+    for (patch, &marker) in w.bpatch.iter_mut().zip(&w.bmarker) {
+        if marker == super::HELD_MARKER {
+            *patch = DEAD; // (never moves, flips nor splits)
+        }
+    }
 
     for v in n_input..n {
         if w.bstar[v].is_empty() || w.star[v].is_empty() {
@@ -225,6 +230,10 @@ pub(crate) fn classify(w: &mut Work, input: Option<&PlcInput>) -> (Vec<Constrain
             Constraint::Line((w.p(b) - w.p(a)).normalize_or_zero())
         } else {
             let p = w.bpatch[w.bstar[v][0] as usize];
+            if p == DEAD {
+                cons[v] = Constraint::Fixed; // on a held triangle
+                continue;
+            }
             let nrm = normals[p as usize];
             let one = w.bstar[v].iter().all(|&t| {
                 let [a, b, c] = w.btri[t as usize].map(|x| w.p(x));
@@ -267,7 +276,9 @@ fn join_flat_patches(w: &mut Work, seg_edge: &dyn Fn(u32, u32) -> bool) -> Union
             let key = edges[i].0;
             let (u, v) = ((key >> 32) as u32, key as u32);
             let flat = coplanar(w, t1, t2);
-            if w.bmarker[t1 as usize] == w.bmarker[t2 as usize] && !seg_edge(u, v) && flat {
+            let held = w.bmarker[t1 as usize] == super::HELD_MARKER;
+            if w.bmarker[t1 as usize] == w.bmarker[t2 as usize] && !held && !seg_edge(u, v) && flat
+            {
                 patches.union(t1, t2);
                 merged = true;
             }

@@ -26,16 +26,16 @@ const MAX_CAVITY: usize = 24;
 /// A planned insertion, applied by [`Improver::apply_insertion`].
 #[derive(Debug, PartialEq)]
 pub(crate) struct Insertion {
-    at: DVec3,
-    kill: Vec<u32>,
+    pub(super) at: DVec3,
+    pub(super) kill: Vec<u32>,
     /// New tets, with `NEW` standing for the new vertex.
-    make: Vec<[u32; 4]>,
-    region: i32,
+    pub(super) make: Vec<[u32; 4]>,
+    pub(super) region: i32,
     pub new_min: f64,
 }
 
 /// Stand-in id of the vertex being planned (never a real vertex id).
-const NEW: u32 = DEAD - 1;
+pub(super) const NEW: u32 = DEAD - 1;
 
 impl Improver<'_> {
     /// The best insertion into a cavity around tet `t`, if one raises the worst objective.
@@ -103,7 +103,7 @@ impl Improver<'_> {
 
     /// The tet of region `region` across face `i` of tet `c`, unless that face is a boundary
     /// triangle or on the hull.
-    fn beyond(&self, c: u32, i: usize, region: i32) -> Option<u32> {
+    pub(super) fn beyond(&self, c: u32, i: usize, region: i32) -> Option<u32> {
         let w = &self.w;
         let f = face(w.tets[c as usize], i);
         if w.is_boundary_face(f) {
@@ -117,7 +117,7 @@ impl Improver<'_> {
     /// The new tets joining `NEW` to the outer faces of `cavity` (tets of region `region`;
     /// each new tet is a cavity tet with the vertex opposite that face replaced), with the
     /// (cavity tet, face) each comes from.
-    fn cone(&self, cavity: &[u32], region: i32) -> (Vec<[u32; 4]>, Vec<(u32, usize)>) {
+    pub(super) fn cone(&self, cavity: &[u32], region: i32) -> (Vec<[u32; 4]>, Vec<(u32, usize)>) {
         let mut make = vec![];
         let mut from = vec![];
         for &c in cavity {
@@ -139,7 +139,7 @@ impl Improver<'_> {
 
     /// Whether every vertex the cone leaves out (all its tets in the cavity) is a free
     /// interior vertex: the insertion deletes it.
-    fn swallows_only_free(&self, cavity: &[u32], make: &[[u32; 4]]) -> bool {
+    pub(super) fn swallows_only_free(&self, cavity: &[u32], make: &[[u32; 4]]) -> bool {
         cavity
             .iter()
             .flat_map(|&c| self.w.tets[c as usize])
@@ -154,6 +154,13 @@ impl Improver<'_> {
     pub(crate) fn apply_insertion(&mut self, plan: Insertion) -> Vec<u32> {
         let v = self.w.add_vertex(plan.at);
         self.cons.push(Constraint::Free);
+        self.stats.insertions += 1;
+        self.fill_cavity(v, &plan)
+    }
+
+    /// The tets of `plan`'s cavity replaced by its new ones, joined to vertex `v` (already
+    /// added at `plan.at`); returns the new tets.
+    pub(super) fn fill_cavity(&mut self, v: u32, plan: &Insertion) -> Vec<u32> {
         let mut old: Vec<u32> = plan
             .kill
             .iter()
@@ -164,7 +171,6 @@ impl Improver<'_> {
         for &t in &plan.kill {
             self.w.kill_tet(t);
         }
-        self.stats.insertions += 1;
         let made = plan
             .make
             .iter()

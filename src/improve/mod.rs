@@ -39,6 +39,7 @@ mod delete;
 mod flips;
 mod insert;
 pub mod quality;
+mod rho_repair;
 mod smooth;
 mod topo;
 
@@ -54,6 +55,11 @@ use rustc_hash::FxHashMap;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 use topo::Work;
+
+/// Boundary marker of triangles the improver must keep exactly as they are (never flipped,
+/// split nor moved, even where coplanar with a neighbour): faces that another mesh shares,
+/// such as a zone's outer faces (`partition::zone`).
+pub const HELD_MARKER: i32 = i32::MIN + 2;
 
 /// What the improver is asked to do.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -72,6 +78,10 @@ pub struct Options {
     /// refused unless a tet it replaces exceeded it already, and then the new ones may not
     /// exceed the worst of those (`ImproveStats::rho_vetoes` counts the refusals); infinite: none.
     pub keep_rho: f64,
+    /// Radius-edge bound that tets are repaired to after the passes, by a vertex at or short
+    /// of their circumcentre (`rho_repair`; the zones of a partitioned run, where refinement
+    /// could not put it in); infinite: no repair.
+    pub repair_rho: f64,
 }
 
 impl Default for Options {
@@ -82,6 +92,7 @@ impl Default for Options {
             max_passes: 4,
             max_rho: f64::INFINITY,
             keep_rho: f64::INFINITY,
+            repair_rho: f64::INFINITY,
         }
     }
 }
@@ -123,6 +134,10 @@ const CLIMB_ROUNDS: usize = 12;
 const CLIMB_STEP_DEG: f64 = 2.0;
 const CLIMB_MAX_TETS: usize = 200;
 const CLIMB_LIMIT_DEG: f64 = 45.0;
+
+/// The worst angle a radius-edge repair may make (`Options::repair_rho`): the passes after it
+/// work on the angles around its vertex.
+const REPAIR_FLOOR_DEG: f64 = 10.0;
 
 /// Smoothings of one vertex per pass at most (each must gain, but gains can be small).
 const MAX_SMOOTHINGS: u8 = 2;
@@ -202,6 +217,12 @@ fn improve_work(
         .filter(|&t| im.w.q[t] < SURELY_POSITIVE && !im.w.positive(im.w.tets[t]))
         .count();
     if opts.improve || im.stats.degenerate_before > 0 {
+        im.run(opts);
+    }
+    let floor = REPAIR_FLOOR_DEG.to_radians().sin();
+    if opts.improve && opts.repair_rho.is_finite() && im.repair_rho(opts.repair_rho, floor) > 0 {
+        // The bound gives way only where the repairs left it unmet.
+        im.w.set_rho_limit(opts.keep_rho);
         im.run(opts);
     }
     im.stats.seconds = start.elapsed().as_secs_f64();
@@ -597,7 +618,24 @@ pub fn finish(
     params: &Params,
     slide: Option<&dyn SurfaceSlide>,
 ) -> Result<(TetMesh, ImproveStats), MeshError> {
-    let opts = Options {
+    finish_with(mesh, input, &finish_options(params), slide)
+}
+
+/// [`finish`] with its options given (from [`finish_options`], changed).
+pub fn finish_with(
+    mesh: TetMesh,
+    input: Option<&PlcInput>,
+    opts: &Options,
+    slide: Option<&dyn SurfaceSlide>,
+) -> Result<(TetMesh, ImproveStats), MeshError> {
+    let (out, stats) = improve_owned(mesh, input, opts, slide);
+    check_no_degenerate(&out)?;
+    Ok((out, stats))
+}
+
+/// The improver's options for a run's `params` (what [`finish`] uses).
+pub fn finish_options(params: &Params) -> Options {
+    Options {
         improve: params.improve,
         // Keep mode leaves tets over rho0 next to small input angles, where the cap made the
         // improver trade angles for them (spool: 4 -> 61 tets below 5 degrees): angles only.
@@ -615,10 +653,7 @@ pub fn finish(
             SurfaceMode::Keep => params.rho0,
         },
         ..Options::default()
-    };
-    let (out, stats) = improve_owned(mesh, input, &opts, slide);
-    check_no_degenerate(&out)?;
-    Ok((out, stats))
+    }
 }
 
 #[cfg(test)]

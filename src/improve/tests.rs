@@ -603,3 +603,67 @@ fn plans_made_ahead_are_the_plans_made_now() {
         assert!((vol(&want) - vol(&mesh)).abs() <= 1e-9 * vol(&mesh));
     }
 }
+
+/// The radius-edge repair (`Options::repair_rho`) on a serial mesh of the cube held to a
+/// tighter bound than it was refined for: vertices go in inside and on the boundary facets
+/// (splitting boundary triangles), no angle falls below the repair's floor, and the mesh
+/// stays a conforming tiling of the same box with the boundary triangles on its surface.
+#[test]
+fn rho_repair_puts_vertices_in_where_tets_are_over_the_bound() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models/poly/cube.poly");
+    let input = crate::io::read_plc(&path, &Default::default()).unwrap();
+    let params = crate::run::params::Params::default();
+    let spacing = crate::run::spacing::ConstantSpacing(0.2);
+    let (mesh, _, _) = crate::pipeline::mesh(&input, &params, Some(&spacing), None).unwrap();
+    let bound = 1.3;
+    let over = |m: &TetMesh| {
+        (m.tets.iter())
+            .filter(|t| {
+                let p = t.map(|v| m.vertices[v as usize]);
+                Work::rho_at(p) > bound
+            })
+            .count()
+    };
+    let opts = Options {
+        repair_rho: bound,
+        keep_rho: bound,
+        ..Options::default()
+    };
+    let (out, stats) = improve(&mesh, Some(&input), &opts);
+    println!("over {bound}: {} -> {}, {stats:?}", over(&mesh), over(&out));
+    assert!(
+        stats.rho_repairs > 0 && over(&out) < over(&mesh),
+        "{stats:?}"
+    );
+    assert!(out.vertices.len() > mesh.vertices.len());
+    assert!(
+        out.boundary.len() > mesh.boundary.len(),
+        "no boundary triangle split"
+    );
+    assert!((vol(&out) - 1.0).abs() < 1e-12, "volume {}", vol(&out));
+    let boundary: std::collections::HashSet<[u32; 3]> = (out.boundary.iter())
+        .map(|b| {
+            let mut k = *b;
+            k.sort_unstable();
+            k
+        })
+        .collect();
+    let mut area = 0.0;
+    for b in &out.boundary {
+        let [x, y, z] = b.map(|v| out.vertices[v as usize]);
+        area += 0.5 * (y - x).cross(z - x).length();
+        let on_side = |p: DVec3| p.to_array().iter().any(|&c| c == 0.0 || c == 1.0);
+        assert!(
+            [x, y, z].into_iter().all(on_side),
+            "{b:?} off the cube's sides"
+        );
+    }
+    assert!((area - 6.0).abs() < 1e-12, "boundary area {area}");
+    for (f, &k) in &out.face_counts() {
+        assert!(
+            k == 2 || (k == 1 && boundary.contains(f)),
+            "face {f:?} in {k} tets"
+        );
+    }
+    assert!(min_q(&out) > 0.0);
+}

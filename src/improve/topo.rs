@@ -354,6 +354,20 @@ impl Work {
         }
     }
 
+    /// Adds boundary triangle `f` with `marker` in `patch`; returns its index.
+    pub fn add_btri(&mut self, f: [u32; 3], marker: i32, patch: u32) -> u32 {
+        let i = self.btri.len() as u32;
+        self.btri.push(f);
+        self.bmarker.push(marker);
+        self.bpatch.push(patch);
+        self.bmap.insert(key3(f), i);
+        for v in f {
+            self.bstar[v as usize].push(i);
+            self.touch(v);
+        }
+        i
+    }
+
     /// Exact orientation test of a would-be tet.
     pub fn positive(&self, t: [u32; 4]) -> bool {
         let [a, b, c, d] = self.points(&t);

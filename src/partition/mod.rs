@@ -35,7 +35,7 @@ use coarse::Coarse;
 use rustc_hash::FxHashSet;
 pub use zone::{
     another_pass, bad_tets, corners, cut_zone, glue, improve_zone, move_interfaces, rejoin,
-    share_zones, Corners, Cut, Share, MAX_INTERFACE_PASSES, ZONE_LAYERS,
+    share_zones, Corners, Cut, Seed, Share, MAX_INTERFACE_PASSES, RHO_REACH_LAYERS, ZONE_LAYERS,
 };
 
 /// One part as [`mesh_part`] gives it.

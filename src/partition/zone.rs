@@ -27,8 +27,13 @@ use rustc_hash::{FxHashMap, FxHashSet};
 /// part.)
 pub const ZONE_LAYERS: usize = 1;
 
-/// Marker of the zone's outer faces while it is improved (fixed, then left out).
-const ZONE_MARKER: i32 = i32::MIN + 2;
+/// Vertex layers more around a tet over rho0 at an interface: its circumcentre, which the
+/// part's refinement refused next to the frozen interface and the zone's radius-edge repair
+/// puts in, is about a circumradius (a spacing or two) away, and must be inside the zone.
+pub const RHO_REACH_LAYERS: usize = 2;
+
+/// Marker of the zone's outer faces while it is improved (held as they are, then left out).
+const ZONE_MARKER: i32 = crate::improve::HELD_MARKER;
 
 /// A part's mesh cut in two.
 pub struct Cut {
@@ -54,15 +59,39 @@ pub fn corners(tri: &[u32], vertices: &[DVec3]) -> Corners {
     k
 }
 
-/// The smallest dihedral angle of `mesh` (degrees; `f64::MAX` for no tet), and which of its
-/// tets are below `target_deg`.
-pub fn bad_tets(mesh: &TetMesh, target_deg: f64) -> (f64, Vec<bool>) {
-    let angles: Vec<f64> = crate::parallel::map_collect(&mesh.tets, |t| {
+/// Why a part's tet seeds its zone ([`bad_tets`], [`cut_zone`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Seed {
+    #[default]
+    No,
+    /// Its smallest dihedral angle is below the improvement target.
+    BelowTarget,
+    /// Its radius-edge ratio is over rho0 (and its angles may be fine).
+    OverRho,
+}
+
+/// The smallest dihedral angle of `mesh` (degrees; `f64::MAX` for no tet), whether a tet is
+/// over radius-edge ratio `rho0`, and which of its tets seed the zone: below `target_deg`,
+/// or over `rho0`.
+pub fn bad_tets(mesh: &TetMesh, target_deg: f64, rho0: f64) -> (f64, bool, Vec<Seed>) {
+    let measures: Vec<(f64, bool)> = crate::parallel::map_collect(&mesh.tets, |t| {
         let p = t.map(|v| mesh.vertices[v as usize]);
-        crate::geom::measures::min_max_dihedral(p[0], p[1], p[2], p[3]).0
+        let angle = crate::geom::measures::min_max_dihedral(p[0], p[1], p[2], p[3]).0;
+        (
+            angle,
+            crate::geom::radius_edge_ratio(p[0], p[1], p[2], p[3]) > rho0,
+        )
     });
-    let worst = angles.iter().copied().fold(f64::MAX, f64::min);
-    (worst, angles.iter().map(|&a| a < target_deg).collect())
+    let worst = measures.iter().map(|m| m.0).fold(f64::MAX, f64::min);
+    let over_rho = measures.iter().any(|m| m.1);
+    let seeds = (measures.iter())
+        .map(|&(angle, over)| match (over, angle < target_deg) {
+            (true, _) => Seed::OverRho,
+            (false, true) => Seed::BelowTarget,
+            (false, false) => Seed::No,
+        })
+        .collect();
+    (worst, over_rho, seeds)
 }
 
 /// The faces of one tet of `mesh` that are not boundary triangles, each as its tet's face.
@@ -123,17 +152,28 @@ fn sub_mesh(mesh: &TetMesh, keep: &[bool]) -> (TetMesh, Vec<bool>) {
     (out, boundary_kept)
 }
 
-/// Cuts a part's mesh into its zone and the rest. The zone grows from the part's triangles
-/// on its interfaces (`interface`, vertex ids of `part`) and from its tets where `bad` is
-/// true. The rest is `part` itself with the zone's tets taken out (no copy of the part).
-pub fn cut_zone(part: TetMesh, interface: &[[u32; 3]], bad: &[bool]) -> Cut {
-    let mut near = vec![false; part.vertices.len()];
-    for f in interface {
-        f.iter().for_each(|&v| near[v as usize] = true);
+/// Cuts a part's mesh into its zone and the rest. The zone grows [`ZONE_LAYERS`] from the
+/// part's triangles on its interfaces (`interface`, vertex ids of `part`) and from its seed
+/// tets, and [`RHO_REACH_LAYERS`] more from the seeds over rho0 that touch an interface. The
+/// rest is `part` itself with the zone's tets taken out (no copy of the part).
+pub fn cut_zone(part: TetMesh, interface: &[[u32; 3]], seeds: &[Seed]) -> Cut {
+    let mut on_interface = vec![false; part.vertices.len()];
+    interface
+        .iter()
+        .flatten()
+        .for_each(|&v| on_interface[v as usize] = true);
+    let mut near = on_interface.clone();
+    let mut reach = vec![false; part.vertices.len()];
+    for (tv, &seed) in part.tets.iter().zip(seeds) {
+        if seed != Seed::No {
+            tv.iter().for_each(|&v| near[v as usize] = true);
+        }
+        if seed == Seed::OverRho && tv.iter().any(|&v| on_interface[v as usize]) {
+            tv.iter().for_each(|&v| reach[v as usize] = true);
+        }
     }
-    for (tv, _) in part.tets.iter().zip(bad).filter(|(_, &b)| b) {
-        tv.iter().for_each(|&v| near[v as usize] = true);
-    }
+    grow_layers(&part.tets, &mut reach, RHO_REACH_LAYERS);
+    near.iter_mut().zip(&reach).for_each(|(n, &r)| *n |= r);
     let mut in_zone = vec![false; part.tets.len()];
     for _ in 0..ZONE_LAYERS {
         for (t, tv) in part.tets.iter().enumerate() {
@@ -148,6 +188,23 @@ pub fn cut_zone(part: TetMesh, interface: &[[u32; 3]], bad: &[bool]) -> Cut {
     let (zone, zone_boundary) = sub_mesh(&part, &in_zone);
     let rest = without_tets(part, &in_zone, &zone_boundary);
     Cut { rest, zone }
+}
+
+/// `marked` vertices grown by `layers` layers of tets (every vertex of a tet with a marked
+/// one is marked).
+fn grow_layers(tets: &[[u32; 4]], marked: &mut [bool], layers: usize) {
+    if !marked.contains(&true) {
+        return;
+    }
+    for _ in 0..layers {
+        let touched: Vec<bool> = tets
+            .iter()
+            .map(|tv| tv.iter().any(|&v| marked[v as usize]))
+            .collect();
+        for (tv, _) in tets.iter().zip(&touched).filter(|(_, &t)| t) {
+            tv.iter().for_each(|&v| marked[v as usize] = true);
+        }
+    }
 }
 
 /// `mesh` without the tets where `drop` is true, in place: the vertices no tet uses any more
@@ -369,9 +426,49 @@ pub fn improve_zone(zone: TetMesh, params: &Params) -> Result<(TetMesh, ImproveS
         vertices: mesh.vertices[..first.iter().filter(|&&f| f).count()].to_vec(),
         ..Default::default()
     };
-    let (mut mesh, stats) = crate::improve::finish(mesh, Some(&fixed), params, None)?;
+    let opts = crate::improve::finish_options(params);
+    let (plain, plain_stats) =
+        crate::improve::finish_with(mesh.clone(), Some(&fixed), &opts, None)?;
+    let (mut mesh, stats) = match repaired_if_better(mesh, &fixed, plain, params)? {
+        Ok(repaired) => repaired,
+        Err(plain) => (plain, plain_stats),
+    };
     mesh.remove_boundary_marker(ZONE_MARKER);
     Ok((mesh, stats))
+}
+
+/// A zone improved with the radius-edge repair (`improve::Options::repair_rho`), if `plain`
+/// (the zone improved without it) has a tet over rho0 and the repair lowers its largest ratio
+/// without a smaller angle than `plain`'s, or than the improvement target. Such tets are the
+/// parts' tets next to their frozen interface whose circumcentres were refused there; in the
+/// zone the old interface is free. Else `plain` back.
+#[allow(clippy::type_complexity)]
+fn repaired_if_better(
+    zone: TetMesh,
+    fixed: &crate::plc::PlcInput,
+    plain: TetMesh,
+    params: &Params,
+) -> Result<Result<(TetMesh, ImproveStats), TetMesh>, MeshError> {
+    let q = crate::quality::measure(&plain)
+        .map_err(|e| MeshError::Internal(format!("measuring a zone: {e}")))?;
+    if q.max_rho <= params.rho0 {
+        return Ok(Err(plain));
+    }
+    let opts = crate::improve::Options {
+        repair_rho: params.rho0,
+        ..crate::improve::finish_options(params)
+    };
+    let (repaired, stats) = crate::improve::finish_with(zone, Some(fixed), &opts, None)?;
+    let r = crate::quality::measure(&repaired)
+        .map_err(|e| MeshError::Internal(format!("measuring a zone: {e}")))?;
+    let floor = q.min_dihedral_deg.min(params.effective_improve_target());
+    Ok(
+        if r.max_rho <= q.max_rho && r.min_dihedral_deg >= floor && stats.rho_repairs > 0 {
+            Ok((repaired, stats))
+        } else {
+            Err(plain)
+        },
+    )
 }
 
 /// `improved` (a part's pieces of the zones) put back into `rest` (the part without its
@@ -429,11 +526,17 @@ pub const MAX_INTERFACE_PASSES: u32 = 3;
 
 /// Whether the interfaces move (again) after `passes` passes: the worst tet of all parts
 /// (`worst`, degrees) is below `target_deg`, and the last pass raised it (from
-/// `worst_before_last`).
-pub fn another_pass(passes: u32, worst_before_last: f64, worst: f64, target_deg: f64) -> bool {
+/// `worst_before_last`); or, for the first pass, a tet is over rho0 (`over_rho`).
+pub fn another_pass(
+    passes: u32,
+    worst_before_last: f64,
+    worst: f64,
+    target_deg: f64,
+    over_rho: bool,
+) -> bool {
     passes < MAX_INTERFACE_PASSES
-        && worst < target_deg
-        && (passes == 0 || worst > worst_before_last)
+        && ((worst < target_deg && (passes == 0 || worst > worst_before_last))
+            || (passes == 0 && over_rho))
 }
 
 /// The parts with their interfaces moved, in one process (`crate::distributed` does the
@@ -445,18 +548,22 @@ pub fn move_interfaces(
     let target = params.effective_improve_target();
     let mut parts: Vec<(TetMesh, Vec<[u32; 3]>)> =
         parts.into_iter().map(|p| (p.mesh, p.interface)).collect();
-    // The worst tet of all parts, and each part's tets below the target.
+    // The worst tet of all parts, whether one is over rho0, and each part's seed tets.
     let measure = |parts: &[(TetMesh, Vec<[u32; 3]>)]| {
-        let (worst, bad): (Vec<f64>, Vec<Vec<bool>>) =
-            parts.iter().map(|(mesh, _)| bad_tets(mesh, target)).unzip();
-        (worst.into_iter().fold(f64::MAX, f64::min), bad)
+        let mut all = (f64::MAX, false, vec![]);
+        for (mesh, _) in parts {
+            let (worst, over_rho, seeds) = bad_tets(mesh, target, params.rho0);
+            all = (all.0.min(worst), all.1 || over_rho, all.2);
+            all.2.push(seeds);
+        }
+        all
     };
-    let (mut worst, mut bad) = measure(&parts);
+    let (mut worst, mut over_rho, mut seeds) = measure(&parts);
     let (mut passes, mut before) = (0, worst);
-    while another_pass(passes, before, worst, target) {
-        let (rests, zones): (Vec<TetMesh>, Vec<TetMesh>) = (parts.into_iter().zip(&bad))
-            .map(|((mesh, interface), bad)| {
-                let cut = cut_zone(mesh, &interface, bad);
+    while another_pass(passes, before, worst, target, over_rho) {
+        let (rests, zones): (Vec<TetMesh>, Vec<TetMesh>) = (parts.into_iter().zip(&seeds))
+            .map(|((mesh, interface), seeds)| {
+                let cut = cut_zone(mesh, &interface, seeds);
                 (cut.rest, cut.zone)
             })
             .unzip();
@@ -467,7 +574,7 @@ pub fn move_interfaces(
             parts.push(rejoin(rest, improved, &share.next_interface));
         }
         (passes, before) = (passes + 1, worst);
-        (worst, bad) = measure(&parts);
+        (worst, over_rho, seeds) = measure(&parts);
     }
     Ok((parts.into_iter().map(|(m, _)| m).collect(), passes))
 }

@@ -290,6 +290,9 @@ pub struct ImproveStats {
     /// Changes made although a new tet exceeds the bound, next to where refinement left it
     /// unmet (small input angles): where rho0 gave way to the dihedral target.
     pub rho_yields: usize,
+    /// Vertices inserted at (or short of) the circumcentre of a tet over the radius-edge
+    /// bound (`improve::Options::repair_rho`).
+    pub rho_repairs: usize,
     pub seconds: f64,
     /// Of which planning topological changes, and smoothing.
     pub seconds_plans: f64,
@@ -306,6 +309,7 @@ impl ImproveStats {
             + self.smoothed
             + self.insertions
             + self.deletions
+            + self.rho_repairs
             > 0
     }
 }
