@@ -138,6 +138,8 @@ const CLIMB_LIMIT_DEG: f64 = 45.0;
 /// The worst angle a radius-edge repair may make (`Options::repair_rho`): the passes after it
 /// work on the angles around its vertex.
 const REPAIR_FLOOR_DEG: f64 = 10.0;
+/// Radius-edge repairs, each followed by the passes, at most.
+const REPAIR_CYCLES: usize = 3;
 
 /// Smoothings of one vertex per pass at most (each must gain, but gains can be small).
 const MAX_SMOOTHINGS: u8 = 2;
@@ -220,7 +222,13 @@ fn improve_work(
         im.run(opts);
     }
     let floor = REPAIR_FLOOR_DEG.to_radians().sin();
-    if opts.improve && opts.repair_rho.is_finite() && im.repair_rho(opts.repair_rho, floor) > 0 {
+    for _ in 0..REPAIR_CYCLES {
+        if !opts.improve
+            || !opts.repair_rho.is_finite()
+            || im.repair_rho(opts.repair_rho, floor) == 0
+        {
+            break;
+        }
         // The bound gives way only where the repairs left it unmet.
         im.w.set_rho_limit(opts.keep_rho);
         im.run(opts);
