@@ -419,7 +419,7 @@ fn fandisk_approximate_on_two_and_three_ranks() {
         println!("skipped: mpirun is not on PATH");
         return;
     }
-    // Measured 22.90 / 25.84 degrees on 2 / 3 ranks (serial 20.00); about 2.3 times the
+    // Measured 26.00 / 25.84 degrees on 2 / 3 ranks (serial 20.00); about 2.3 times the
     // serial tet count (the parts mesh the triangulated surface in keep mode, whose edges are
     // all input segments).
     check_approximate("fandisk", &[2, 3]);

@@ -225,7 +225,7 @@ fn improve_work(
     for _ in 0..REPAIR_CYCLES {
         if !opts.improve
             || !opts.repair_rho.is_finite()
-            || im.repair_rho(opts.repair_rho, floor) == 0
+            || im.repair_rho(opts.repair_rho, floor, opts.target_deg.to_radians().sin()) == 0
         {
             break;
         }

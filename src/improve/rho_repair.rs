@@ -10,13 +10,18 @@
 //! grown across every outer face that the point does not see (the mesh need not be
 //! Delaunay); the point is joined to its outer faces (`Improver::cone`). The change is made
 //! only when every new tet is positively oriented by the exact `orient3d` (so the cone tiles
-//! the cavity), none exceeds the bound, and the worst new angle objective is at least
-//! `floor`. When the circumcentre fails (outside the domain or the zone, or a new tet over
-//! the bound), points on the way back to the tet's centroid are tried. The improver's passes
-//! then work on the angles around the new vertices (`improve_work`).
+//! the cavity), none exceeds the bound (failing that, the largest new ratio is below the bad
+//! tet's, and a later round goes on), and the worst new angle objective is at least `floor`. Around the circumcentre and on the way back to the tet's centroid several points
+//! are tried ([`candidates`]); where none has its new tets within the bound, the best one's
+//! point is moved by the improver's ascent on the objective capped at the bound. Where the
+//! circumcentre encroaches a boundary triangle of a flat patch (beyond it or in its equatorial
+//! ball), the patch's triangles around the point are split instead, as refinement splits an
+//! encroached subfacet ([`Improver::plan_boundary_split`]). The improver's passes then work on
+//! the angles around the new vertices (`improve_work`).
 
 use super::constraints::Constraint;
 use super::insert::{Insertion, NEW};
+use super::quality::Objective;
 use super::topo::{edge_key, face, key3, Work, DEAD};
 use super::Improver;
 use crate::geom::{circumsphere, equatorial_ball, insphere, orient3d, tri_circumcenter};
@@ -35,8 +40,9 @@ const REPAIR_ROUNDS: usize = 3;
 
 impl Improver<'_> {
     /// Repairs the tets over radius-edge ratio `bound`, worst first, in rounds, with new tets
-    /// no worse than angle objective `floor`. Returns how many vertices went in.
-    pub(super) fn repair_rho(&mut self, bound: f64, floor: f64) -> usize {
+    /// no worse than angle objective `floor` (`target`: the sine of the improvement target).
+    /// Returns how many vertices went in.
+    pub(super) fn repair_rho(&mut self, bound: f64, floor: f64, target: f64) -> usize {
         let mut repaired = 0;
         for _ in 0..REPAIR_ROUNDS {
             let mut over: Vec<(f64, u32)> = (0..self.w.tets.len() as u32)
@@ -57,7 +63,7 @@ impl Improver<'_> {
                 // around the point), as refinement would; else a point inside.
                 if let Some(plan) = self.plan_boundary_split(t, bound, floor) {
                     self.apply_boundary_split(plan);
-                } else if let Some(plan) = self.plan_rho_repair(t, bound, floor) {
+                } else if let Some(plan) = self.plan_rho_repair(t, bound, floor, target) {
                     let v = self.w.add_vertex(plan.at);
                     self.cons.push(Constraint::Free);
                     self.fill_cavity(v, &plan);
@@ -79,7 +85,14 @@ impl Improver<'_> {
     /// new tet worse than `floor`: the one with the best worst new tet among those whose new
     /// tets are all within `bound`, else the one whose worst new tet has the smallest
     /// radius-edge ratio if that is below `t`'s (a later round goes on from there).
-    fn plan_rho_repair(&self, t: u32, bound: f64, floor: f64) -> Option<Insertion> {
+    /// If none is within the bound, the best moved by [`Self::placed_for_rho`] may be.
+    fn plan_rho_repair(
+        &mut self,
+        t: u32,
+        bound: f64,
+        floor: f64,
+        target: f64,
+    ) -> Option<Insertion> {
         let w = &self.w;
         let corners = w.points(&w.tets[t as usize]);
         let region = w.region[t as usize];
@@ -114,7 +127,49 @@ impl Improver<'_> {
             }
         }
         let (within, value, plan) = best?;
-        (within || -value < Work::rho_at(corners)).then_some(plan)
+        if within {
+            return Some(plan);
+        }
+        let rho_t = Work::rho_at(corners);
+        match self.placed_for_rho(&plan, bound, floor, target) {
+            Some(placed) => Some(placed),
+            None => (-value < rho_t).then_some(plan),
+        }
+    }
+
+    /// `plan`'s point moved by the improver's ascent on the objective capped at `bound`
+    /// (`quality::Objective`, its `rho_weight` for `target`, the sine of the target angle), in
+    /// the same cavity: the plan there if all its new tets are then valid, within the bound
+    /// and no worse than `floor` in angle.
+    fn placed_for_rho(
+        &mut self,
+        plan: &Insertion,
+        bound: f64,
+        floor: f64,
+        target: f64,
+    ) -> Option<Insertion> {
+        let angles = self.w.objective;
+        self.w.objective = Objective {
+            rho_weight: target * bound,
+            ..angles
+        };
+        let q0 = self.star_min(&plan.make, NEW, plan.at);
+        let (at, _) = self.ascend(&plan.make, NEW, plan.at, q0, Constraint::Free);
+        self.w.objective = angles;
+        let new = |tv: &[u32; 4]| tv.map(|v| if v == NEW { at } else { self.w.p(v) });
+        let valid = plan.make.iter().all(|tv| {
+            let p = new(tv);
+            orient3d(p[0], p[1], p[2], p[3]) > 0.0
+        });
+        let within = plan.make.iter().all(|tv| Work::rho_at(new(tv)) <= bound);
+        let new_min = self.star_min(&plan.make, NEW, at);
+        (valid && within && new_min >= floor).then(|| Insertion {
+            at,
+            kill: plan.kill.clone(),
+            make: plan.make.clone(),
+            region: plan.region,
+            new_min,
+        })
     }
 
     /// The cavity for a point at `at` (see the module comment), or None if the point is not
