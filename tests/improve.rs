@@ -209,3 +209,63 @@ fn acute_others() {
         acute(rel, floor_deg, ceiling_deg);
     }
 }
+
+/// The radius-edge repair (`improve::Options::repair_rho`, what the zones of a partitioned
+/// run use) on a serial mesh of the cube held to a tighter bound than it was refined for:
+/// vertices go in inside and on the boundary facets (splitting boundary triangles), and the
+/// mesh stays a conforming tiling of the same box with its boundary triangles on its sides.
+#[test]
+fn rho_repair_puts_vertices_in_where_tets_are_over_the_bound() {
+    let input = read_model("poly/cube.poly");
+    let spacing = slivermesh::run::spacing::ConstantSpacing(0.2);
+    let params = slivermesh::run::params::Params::default();
+    let (mesh, _, _) = slivermesh::pipeline::mesh(&input, &params, Some(&spacing), None).unwrap();
+    let bound = 1.3;
+    let over = |m: &TetMesh| {
+        (m.tets.iter())
+            .filter(|t| {
+                let p = t.map(|v| m.vertices[v as usize]);
+                slivermesh::geom::radius_edge_ratio(p[0], p[1], p[2], p[3]) > bound
+            })
+            .count()
+    };
+    let opts = improve::Options {
+        repair_rho: bound,
+        keep_rho: bound,
+        ..improve::Options::default()
+    };
+    let (out, stats) = improve::improve(&mesh, Some(&input), &opts);
+    println!("over {bound}: {} -> {}, {stats:?}", over(&mesh), over(&out));
+    assert!(
+        stats.rho_repairs > 0 && over(&out) < over(&mesh),
+        "{stats:?}"
+    );
+    assert!(out.vertices.len() > mesh.vertices.len());
+    assert!(
+        out.boundary.len() > mesh.boundary.len(),
+        "no boundary triangle split"
+    );
+    check_orientation(&out);
+    improve::check_no_degenerate(&out).unwrap();
+    check_boundary_faces_are_tet_faces(&out);
+    let volume = total_volume(&out);
+    assert!((volume - 1.0).abs() < 1e-12, "volume {volume}");
+    let mut area = 0.0;
+    for b in &out.boundary {
+        let [x, y, z] = b.map(|v| out.vertices[v as usize]);
+        area += 0.5 * (y - x).cross(z - x).length();
+        let on_side = |p: slivermesh::DVec3| p.to_array().iter().any(|&c| c == 0.0 || c == 1.0);
+        assert!(
+            [x, y, z].into_iter().all(on_side),
+            "{b:?} off the cube's sides"
+        );
+    }
+    assert!((area - 6.0).abs() < 1e-12, "boundary area {area}");
+    let boundary = boundary_keys(&out);
+    for (f, &k) in &out.face_counts() {
+        assert!(
+            k == 2 || (k == 1 && boundary.contains(f)),
+            "face {f:?} in {k} tets"
+        );
+    }
+}
