@@ -107,9 +107,7 @@ impl Improver<'_> {
             if new_min < floor || !self.swallows_only_free(&cavity, &make) {
                 continue;
             }
-            let new_rho = (make.iter())
-                .map(|tv| Work::rho_at(tv.map(|v| if v == NEW { at } else { w.p(v) })))
-                .fold(0.0, f64::max);
+            let new_rho = self.cone_rho(&make, at);
             let rank = if new_rho <= bound {
                 (true, new_min)
             } else {
@@ -156,12 +154,8 @@ impl Improver<'_> {
         let q0 = self.star_min(&plan.make, NEW, plan.at);
         let (at, _) = self.ascend(&plan.make, NEW, plan.at, q0, Constraint::Free);
         self.w.objective = angles;
-        let new = |tv: &[u32; 4]| tv.map(|v| if v == NEW { at } else { self.w.p(v) });
-        let valid = plan.make.iter().all(|tv| {
-            let p = new(tv);
-            orient3d(p[0], p[1], p[2], p[3]) > 0.0
-        });
-        let within = plan.make.iter().all(|tv| Work::rho_at(new(tv)) <= bound);
+        let valid = self.cone_positive(&plan.make, at);
+        let within = self.cone_rho(&plan.make, at) <= bound;
         let new_min = self.star_min(&plan.make, NEW, at);
         (valid && within && new_min >= floor).then(|| Insertion {
             at,
@@ -170,6 +164,27 @@ impl Improver<'_> {
             region: plan.region,
             new_min,
         })
+    }
+
+    /// Tet `tv` of a cone with `NEW` at `at`.
+    fn cone_tet(&self, tv: &[u32; 4], at: DVec3) -> [DVec3; 4] {
+        tv.map(|v| if v == NEW { at } else { self.w.p(v) })
+    }
+
+    /// Whether every tet of cone `make` is positively oriented (exact `orient3d`), `NEW` at
+    /// `at`.
+    fn cone_positive(&self, make: &[[u32; 4]], at: DVec3) -> bool {
+        make.iter().all(|tv| {
+            let p = self.cone_tet(tv, at);
+            orient3d(p[0], p[1], p[2], p[3]) > 0.0
+        })
+    }
+
+    /// The largest radius-edge ratio of the tets of cone `make`, `NEW` at `at`.
+    fn cone_rho(&self, make: &[[u32; 4]], at: DVec3) -> f64 {
+        (make.iter())
+            .map(|tv| Work::rho_at(self.cone_tet(tv, at)))
+            .fold(0.0, f64::max)
     }
 
     /// The cavity for a point at `at` (see the module comment), or None if the point is not
@@ -406,21 +421,14 @@ impl Improver<'_> {
         {
             return None;
         }
-        let new = |tv: &[u32; 4]| tv.map(|v| if v == NEW { at } else { w.p(v) });
         let all_new: Vec<[u32; 4]> = make
             .iter()
             .chain(other.iter().flat_map(|o| &o.make))
             .copied()
             .collect();
-        let valid = all_new.iter().all(|tv| {
-            let p = new(tv);
-            orient3d(p[0], p[1], p[2], p[3]) > 0.0
-        });
         let new_min = self.star_min(&all_new, NEW, at);
-        let new_rho = (all_new.iter())
-            .map(|tv| Work::rho_at(new(tv)))
-            .fold(0.0, f64::max);
-        let fine = valid
+        let new_rho = self.cone_rho(&all_new, at);
+        let fine = self.cone_positive(&all_new, at)
             && new_min >= floor
             && self.swallows_only_free(&cavity, &make)
             && other

@@ -174,17 +174,10 @@ pub fn cut_zone(part: TetMesh, interface: &[[u32; 3]], seeds: &[Seed]) -> Cut {
     }
     grow_layers(&part.tets, &mut reach, RHO_REACH_LAYERS);
     near.iter_mut().zip(&reach).for_each(|(n, &r)| *n |= r);
-    let mut in_zone = vec![false; part.tets.len()];
-    for _ in 0..ZONE_LAYERS {
-        for (t, tv) in part.tets.iter().enumerate() {
-            in_zone[t] |= tv.iter().any(|&v| near[v as usize]);
-        }
-        for (t, tv) in part.tets.iter().enumerate() {
-            if in_zone[t] {
-                tv.iter().for_each(|&v| near[v as usize] = true);
-            }
-        }
-    }
+    grow_layers(&part.tets, &mut near, ZONE_LAYERS - 1);
+    let in_zone: Vec<bool> = (part.tets.iter())
+        .map(|tv| tv.iter().any(|&v| near[v as usize]))
+        .collect();
     let (zone, zone_boundary) = sub_mesh(&part, &in_zone);
     let rest = without_tets(part, &in_zone, &zone_boundary);
     Cut { rest, zone }
@@ -550,13 +543,13 @@ pub fn move_interfaces(
         parts.into_iter().map(|p| (p.mesh, p.interface)).collect();
     // The worst tet of all parts, whether one is over rho0, and each part's seed tets.
     let measure = |parts: &[(TetMesh, Vec<[u32; 3]>)]| {
-        let mut all = (f64::MAX, false, vec![]);
+        let (mut worst, mut over_rho, mut seeds) = (f64::MAX, false, vec![]);
         for (mesh, _) in parts {
-            let (worst, over_rho, seeds) = bad_tets(mesh, target, params.rho0);
-            all = (all.0.min(worst), all.1 || over_rho, all.2);
-            all.2.push(seeds);
+            let (w, o, s) = bad_tets(mesh, target, params.rho0);
+            (worst, over_rho) = (worst.min(w), over_rho || o);
+            seeds.push(s);
         }
-        all
+        (worst, over_rho, seeds)
     };
     let (mut worst, mut over_rho, mut seeds) = measure(&parts);
     let (mut passes, mut before) = (0, worst);
